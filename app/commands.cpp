@@ -1,0 +1,25 @@
+#include "commands.h"
+
+#include <map>
+
+namespace lumar::app {
+
+namespace {
+std::map<CLI::App*, std::function<void()>>& actions() {
+  static std::map<CLI::App*, std::function<void()>> m;
+  return m;
+}
+}  // namespace
+
+void add_action(CLI::App* sub, std::function<void()> run) { actions()[sub] = std::move(run); }
+
+void register_commands(CLI::App& app) {
+  (void)app;
+}
+
+void run_selected(CLI::App& app) {
+  for (auto* sub : app.get_subcommands())
+    if (auto it = actions().find(sub); it != actions().end()) it->second();
+}
+
+}  // namespace lumar::app

@@ -1,0 +1,37 @@
+// lumar: the command line. Each subcommand lives in its own file (cmd_*.cpp) and
+// registers itself through register_*(); errors become one line and an exit status.
+#include <CLI/CLI.hpp>
+#include <cstdio>
+#include <spdlog/spdlog.h>
+
+#include "commands.h"
+#include "lumar/core/error.h"
+
+int main(int argc, char** argv) {
+  CLI::App app{"lumar: composite virtual diffuse objects, lit by the real room, into camera video"};
+  app.set_version_flag("--version", LUMAR_VERSION);
+  app.require_subcommand(1);
+  bool verbose = false;
+  app.add_flag("-v,--verbose", verbose, "Log more detail to stderr");
+  lumar::app::register_commands(app);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e) == 0 ? 0 : 2;
+  }
+  spdlog::set_level(verbose ? spdlog::level::debug : spdlog::level::info);
+  spdlog::set_pattern("%v");
+  try {
+    lumar::app::run_selected(app);
+    return 0;
+  } catch (const lumar::InputError& e) {
+    std::fprintf(stderr, "lumar: error: %s\n", e.what());
+    return 2;
+  } catch (const lumar::RuntimeError& e) {
+    std::fprintf(stderr, "lumar: failed: %s\n", e.what());
+    return 1;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "lumar: failed: %s\n", e.what());
+    return 1;
+  }
+}

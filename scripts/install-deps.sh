@@ -1,0 +1,35 @@
+#!/usr/bin/env bash
+# Installs every Debian 12 package Lumar needs to build, run and test.
+# Safe to re-run: packages already present are skipped by apt-get.
+set -euo pipefail
+
+packages=(
+  build-essential cmake ninja-build pkg-config
+  libopencv-dev                      # calibration, video I/O, image processing
+  libembree-dev                      # ray queries (Embree 3)
+  libopenimageio-dev                 # EXR / HDR environment maps
+  libglfw3-dev libglm-dev libepoxy-dev libegl-dev libegl1-mesa-dev
+  libgl1-mesa-dri                    # Mesa llvmpipe: OpenGL 4.5 core without a GPU
+  libserial-dev libusb-1.0-0-dev libv4l-dev
+  libtbb-dev
+  libcli11-dev nlohmann-json3-dev libspdlog-dev libfmt-dev
+  libassimp-dev                      # OBJ, PLY, glTF meshes
+  zlib1g-dev
+  libgtest-dev libgmock-dev libbenchmark-dev
+  xvfb xauth                         # window tests under xvfb-run
+)
+
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if [ ${#missing[@]} -eq 0 ]; then
+  echo "install-deps: all ${#packages[@]} packages present"
+  exit 0
+fi
+echo "install-deps: installing ${#missing[@]} missing packages: ${missing[*]}"
+SUDO=""
+[ "$(id -u)" -eq 0 ] || SUDO="sudo"
+export DEBIAN_FRONTEND=noninteractive
+$SUDO apt-get update -qq
+$SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
