@@ -14,7 +14,12 @@ std::map<CLI::App*, std::function<void()>>& actions() {
 void add_action(CLI::App* sub, std::function<void()> run) { actions()[sub] = std::move(run); }
 
 void register_commands(CLI::App& app) {
-  (void)app;
+  register_synth(app);
+  register_overlay(app);
+  register_regress(app);
+  register_calibrate(app);
+  register_tracker(app);
+  register_devices(app);
 }
 
 void run_selected(CLI::App& app) {

@@ -1,12 +1,27 @@
 #pragma once
+// Subcommands of `lumar`. Each cmd_*.cpp defines one register_* function that adds its
+// subcommand and the action to run when the user chose it.
 #include <CLI/CLI.hpp>
 #include <functional>
 
 namespace lumar::app {
 
-// Adds every subcommand to `app`.
 void register_commands(CLI::App& app);
 // Runs the subcommand the user chose (after parsing).
 void run_selected(CLI::App& app);
+// Used by the register_* functions.
+void add_action(CLI::App* subcommand, std::function<void()> run);
+
+void register_synth(CLI::App& app);
+void register_overlay(CLI::App& app);
+void register_regress(CLI::App& app);
+void register_calibrate(CLI::App& app);
+// `lumar tracker ...`: the parent command; its subcommands register themselves on it.
+void register_tracker(CLI::App& app);
+void register_tracker_decode(CLI::App& tracker);
+void register_tracker_emulate(CLI::App& tracker);
+void register_tracker_record(CLI::App& tracker);
+// `lumar devices`: serial ports, Polhemus USB devices and USB-serial adapters.
+void register_devices(CLI::App& app);
 
 }  // namespace lumar::app

@@ -45,8 +45,10 @@ glm::dquat axis_angle_deg(const glm::dvec3& axis, double angle_deg) {
 }
 
 double rotation_angle_deg(const glm::dquat& a, const glm::dquat& b) {
-  double d = std::abs(glm::dot(glm::normalize(a), glm::normalize(b)));
-  return glm::degrees(2.0 * std::acos(std::min(1.0, d)));
+  // atan2 of the relative rotation keeps precision near zero, where acos does not.
+  const glm::dquat r = glm::conjugate(glm::normalize(a)) * glm::normalize(b);
+  const double s = glm::length(glm::dvec3(r.x, r.y, r.z));
+  return glm::degrees(2.0 * std::atan2(s, std::abs(r.w)));
 }
 
 Pose interpolate(const Pose& a, const Pose& b, double s) {

@@ -1,0 +1,66 @@
+// lumar overlay: composite the scene's virtual objects into a recording's video.
+#include <memory>
+#include <optional>
+#include <spdlog/spdlog.h>
+
+#include "commands.h"
+#include "lumar/core/error.h"
+#include "output_files.h"
+#include "replay_overlay.h"
+
+namespace lumar::app {
+
+namespace {
+struct OverlayOptions {
+  std::string recording, scene, out, frames_dir, poses = "tracker";
+  bool window = false;
+  int max_frames = 0;
+};
+}  // namespace
+
+void register_overlay(CLI::App& app) {
+  auto o = std::make_shared<OverlayOptions>();
+  auto* cmd = app.add_subcommand("overlay", "Composite virtual objects into a recording's video (headless or in a window)");
+  cmd->add_option("--recording", o->recording, "Recording directory (video + tracker stream + session.json)")
+      ->required();
+  cmd->add_option("--scene", o->scene, "Scene manifest; default: the one the recording's session names");
+  cmd->add_option("--out", o->out, "Output video (.mp4, .mkv or .avi)");
+  cmd->add_option("--frames-dir", o->frames_dir, "Also write every output frame as PNG into this new folder");
+  cmd->add_option("--poses", o->poses, "Camera poses from the tracker stream or from the recording's ground truth")
+      ->check(CLI::IsMember({"tracker", "truth"}))->capture_default_str();
+  cmd->add_flag("--window", o->window, "Show the result in a window (needs a display)");
+  cmd->add_option("--max-frames", o->max_frames, "Stop after this many frames (0 = all)")->capture_default_str();
+  add_action(cmd, [o] {
+    if (o->out.empty() && o->frames_dir.empty() && !o->window)
+      throw InputError("overlay: nothing to do; give --out, --frames-dir or --window");
+    ReplayOverlay overlay(o->recording, o->scene, o->poses == "truth" ? PoseSource::Truth : PoseSource::Tracker,
+                          o->window);
+    const auto& camera = overlay.replay().session().camera;
+    const double fps = overlay.replay().reader().session().value("video", nlohmann::json::object()).value("fps", 30.0);
+    std::optional<VideoOutput> video;
+    std::optional<FramesOutput> frames;
+    if (!o->out.empty()) video.emplace(o->out, fps, cv::Size(camera.width, camera.height));
+    if (!o->frames_dir.empty()) frames.emplace(o->frames_dir);
+    overlay.run(o->max_frames, [&](const OverlayFrame& f) {
+      if (video) video->write(f.composite);
+      if (frames) frames->write(f.index, f.composite);
+      if (auto* w = overlay.window()) {
+        w->present(f.composite);
+        w->poll_events();
+        return !w->should_close();
+      }
+      return true;
+    });
+    if (video) video->commit();
+    if (frames) frames->commit();
+    const auto& stats = overlay.replay().tracker_stats();
+    spdlog::info("overlay: {} frames{}{}; tracker: {} records, {} rejected, {} bytes skipped",
+                 overlay.times().frames, o->out.empty() ? "" : " -> " + o->out,
+                 video ? " (" + video->codec() + ")" : "", stats.records, stats.rejected_records, stats.skipped_bytes);
+    if (overlay.frames_without_pose() > 0)
+      spdlog::warn("overlay: {} frames had no tracker pose and show the video alone", overlay.frames_without_pose());
+    spdlog::info("{}", format_stage_times(overlay.times()));
+  });
+}
+
+}  // namespace lumar::app

@@ -1,0 +1,211 @@
+// lumar regress: replay recordings through the overlay path and compare with their
+// expected results (golden frames, where the virtual object projects).
+#include <fmt/format.h>
+#include <fstream>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <opencv2/calib3d.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+#include <spdlog/spdlog.h>
+
+#include "commands.h"
+#include "lumar/core/error.h"
+#include "replay_overlay.h"
+
+namespace lumar::app {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+namespace {
+
+struct RegressOptions {
+  std::vector<std::string> recordings;
+  std::string root = "recordings";
+  bool update = false;
+};
+
+const cv::Size kGoldenSize(160, 120);
+
+// Mean distance between where the object's points project with the tracked and the true pose.
+double projection_error_px(const CameraIntrinsics& camera, const std::vector<glm::dvec3>& points, const Pose& tracked,
+                           const Pose& truth) {
+  const Pose a = tracked.inverse(), b = truth.inverse();
+  double sum = 0;
+  for (const auto& p : points) sum += glm::length(project_pinhole(camera, a.apply(p)) - project_pinhole(camera, b.apply(p)));
+  return points.empty() ? 0.0 : sum / points.size();
+}
+
+// Mean distance between the pixel where the renderer drew each visible object point
+// and where cv::projectPoints puts that point, for the true pose.
+double render_vs_opencv_px(Compositor& compositor, const Pose& T_world_camera, std::size_t* covered) {
+  const cv::Mat positions = compositor.renderer().render_object_world_positions(T_world_camera);
+  std::vector<cv::Point3d> world;
+  std::vector<cv::Point2d> pixel;
+  for (int r = 0; r < positions.rows; ++r)
+    for (int c = 0; c < positions.cols; ++c) {
+      const cv::Vec4f p = positions.at<cv::Vec4f>(r, c);
+      if (p[3] > 0.5f) {
+        world.emplace_back(p[0], p[1], p[2]);
+        pixel.emplace_back(c, r);
+      }
+    }
+  *covered = world.size();
+  if (world.empty()) return 0.0;
+  const Pose T_camera_world = T_world_camera.inverse();
+  const glm::dmat3 R = T_camera_world.rotation_matrix();
+  cv::Matx33d Rcv;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) Rcv(i, j) = R[j][i];
+  cv::Vec3d rvec, tvec(T_camera_world.translation.x, T_camera_world.translation.y, T_camera_world.translation.z);
+  cv::Rodrigues(Rcv, rvec);
+  std::vector<cv::Point2d> projected;
+  cv::projectPoints(world, rvec, tvec, cv::Mat(compositor.output_camera().camera_matrix()), cv::Mat(), projected);
+  double sum = 0;
+  for (std::size_t i = 0; i < world.size(); ++i) sum += cv::norm(projected[i] - pixel[i]);
+  return sum / world.size();
+}
+
+json read_json(const fs::path& file) {
+  std::ifstream in(file);
+  if (!in) throw InputError(file.string() + ": cannot read");
+  try {
+    return json::parse(in);
+  } catch (const json::parse_error& e) {
+    throw InputError(file.string() + ": malformed JSON (" + e.what() + ")");
+  }
+}
+
+void write_json_atomically(const fs::path& file, const json& j) {
+  const fs::path tmp = file.string() + ".tmp";
+  {
+    std::ofstream out(tmp);
+    out << j.dump(2) << "\n";
+    if (!out) throw RuntimeError(tmp.string() + ": cannot write");
+  }
+  fs::rename(tmp, file);
+}
+
+struct Outcome {
+  bool pass = true;
+  std::string line;
+};
+
+Outcome regress_one(const fs::path& dir, bool update) {
+  const fs::path expected_file = dir / "expected.json";
+  json expected = update ? json::object() : read_json(expected_file);
+  std::vector<std::int64_t> golden;
+  if (!update) golden = expected.at("golden_frames").get<std::vector<std::int64_t>>();
+
+  ReplayOverlay overlay(dir, "", PoseSource::Tracker, false);
+  const auto& frames = overlay.replay().reader().frames();
+  if (frames.empty()) throw InputError(dir.string() + ": recording holds no frames");
+  if (overlay.replay().reader().truth().empty()) throw InputError(dir.string() + ": regression needs truth.csv");
+  if (update) {
+    const std::int64_t last = frames.back().index;
+    golden = {0, last / 3, 2 * last / 3, last};
+  }
+
+  std::map<std::int64_t, cv::Mat> outputs;
+  std::vector<double> tracked_errors;
+  const auto& points = overlay.compositor().object_points();
+  overlay.run(0, [&](const OverlayFrame& f) {
+    if (std::find(golden.begin(), golden.end(), f.index) != golden.end()) {
+      cv::Mat small;
+      cv::resize(f.composite, small, kGoldenSize, 0, 0, cv::INTER_AREA);
+      outputs[f.index] = small;
+    }
+    const auto truth = overlay.replay().true_camera_pose(f.index);
+    if (truth && f.T_world_camera)
+      tracked_errors.push_back(projection_error_px(overlay.compositor().output_camera(), points, *f.T_world_camera, *truth));
+    return true;
+  });
+
+  double psnr_min = 1e9;
+  std::vector<double> psnrs;
+  double render_error = 0;
+  std::size_t render_samples = 0;
+  fs::create_directories(dir / "expected");
+  for (std::int64_t index : golden) {
+    if (!outputs.count(index)) throw InputError(dir.string() + ": golden frame " + std::to_string(index) + " is not in the video");
+    const fs::path png = dir / "expected" / fmt::format("frame-{:06d}.png", index);
+    if (update) {
+      if (!cv::imwrite(png.string(), outputs[index])) throw RuntimeError(png.string() + ": cannot write");
+      psnrs.push_back(99.0);
+    } else {
+      const cv::Mat want = cv::imread(png.string(), cv::IMREAD_COLOR);
+      if (want.empty()) throw InputError(png.string() + ": missing or unreadable golden frame");
+      if (want.size() != outputs[index].size()) throw InputError(png.string() + ": golden frame has the wrong size");
+      const double p = std::min(99.0, cv::PSNR(want, outputs[index]));
+      psnrs.push_back(p);
+      psnr_min = std::min(psnr_min, p);
+    }
+    std::size_t covered = 0;
+    const double e = render_vs_opencv_px(overlay.compositor(), *overlay.replay().true_camera_pose(index), &covered);
+    render_error += e * covered;
+    render_samples += covered;
+  }
+  render_error = render_samples ? render_error / render_samples : 0.0;
+  double tracked_mean = 0, tracked_max = 0;
+  for (double e : tracked_errors) tracked_mean += e, tracked_max = std::max(tracked_max, e);
+  tracked_mean = tracked_errors.empty() ? 0 : tracked_mean / tracked_errors.size();
+
+  if (update) {
+    expected = {{"golden_frames", golden},
+                {"golden_size", {kGoldenSize.width, kGoldenSize.height}},
+                {"psnr_min_db", 35.0},
+                {"tracked_projection_mean_px_max", std::ceil((tracked_mean * 1.25 + 0.5) * 10) / 10},
+                {"render_projection_mean_px_max", 0.5},
+                {"measured",
+                 {{"tracked_projection_mean_px", tracked_mean},
+                  {"tracked_projection_worst_frame_px", tracked_max},
+                  {"render_projection_mean_px", render_error},
+                  {"render_projection_pixels", render_samples}}}};
+    write_json_atomically(expected_file, expected);
+  }
+  const double psnr_limit = expected.at("psnr_min_db").get<double>();
+  const double tracked_limit = expected.at("tracked_projection_mean_px_max").get<double>();
+  const double render_limit = expected.at("render_projection_mean_px_max").get<double>();
+  Outcome o;
+  o.pass = (update || psnr_min >= psnr_limit) && tracked_mean <= tracked_limit && render_error <= render_limit &&
+           render_samples > 0 && tracked_errors.size() == frames.size();
+  o.line = fmt::format(
+      "{} {}: {} frames; golden PSNR min {} (>= {:.0f} dB); tracked-pose projection error mean {:.2f} px, worst "
+      "frame {:.2f} px (mean <= {:.1f}); render vs cv::projectPoints {:.4f} px over {} pixels (<= {:.1f}){}",
+      o.pass ? "PASS" : "FAIL", dir.string(), frames.size(), update ? std::string("(updated)") : fmt::format("{:.1f} dB", psnr_min),
+      psnr_limit, tracked_mean, tracked_max, tracked_limit, render_error, render_samples, render_limit,
+      tracked_errors.size() == frames.size() ? "" : fmt::format("; {} frames lacked a pose", frames.size() - tracked_errors.size()));
+  return o;
+}
+
+}  // namespace
+
+void register_regress(CLI::App& app) {
+  auto o = std::make_shared<RegressOptions>();
+  auto* cmd = app.add_subcommand("regress", "Replay recordings through the overlay and compare with expected results");
+  cmd->add_option("recordings", o->recordings, "Recording directories (default: every one under --root)");
+  cmd->add_option("--root", o->root, "Folder of recordings")->capture_default_str();
+  cmd->add_flag("--update", o->update, "Write new golden frames and expected.json instead of comparing");
+  add_action(cmd, [o] {
+    std::vector<fs::path> dirs(o->recordings.begin(), o->recordings.end());
+    if (dirs.empty()) {
+      if (!fs::is_directory(o->root)) throw InputError(o->root + ": no such folder of recordings");
+      for (const auto& e : fs::directory_iterator(o->root))
+        if (fs::exists(e.path() / "session.json")) dirs.push_back(e.path());
+      std::sort(dirs.begin(), dirs.end());
+      if (dirs.empty()) throw InputError(o->root + ": holds no recordings");
+    }
+    int passed = 0, failed = 0;
+    for (const auto& dir : dirs) {
+      const Outcome r = regress_one(dir, o->update);
+      std::printf("%s\n", r.line.c_str());
+      std::fflush(stdout);
+      (r.pass ? passed : failed)++;
+    }
+    std::printf("regress: %d passed, %d failed\n", passed, failed);
+    if (failed > 0) throw RuntimeError(fmt::format("{} of {} recordings failed regression", failed, dirs.size()));
+  });
+}
+
+}  // namespace lumar::app

@@ -1,0 +1,119 @@
+// lumar tracker decode: raw tracker bytes (a capture of the serial line, or a
+// recording's tracker.raw) -> CSV of poses, with a summary line on stderr.
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <iterator>
+#include <memory>
+#include <sstream>
+#include <string>
+
+#include "commands.h"
+#include "lumar/capture/recording_format.h"
+#include "lumar/core/error.h"
+#include "lumar/tracking/tracker_decode.h"
+// parse_tracker_chunks is private to capture/ (capture/src); the decoder needs exactly
+// that reader, so it is included from there rather than copied.
+#include "../capture/src/tracker_raw.h"
+
+namespace lumar::app {
+
+namespace {
+
+struct DecodeOptions {
+  std::string file;
+  std::string device = "isotrak2";
+  bool binary = false;
+  std::string units = "in";
+  std::string list = "2,4,1";
+  std::string out;
+};
+
+std::string read_file(const std::string& path) {
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec))
+    throw InputError(path + ": no such file; give a raw tracker capture or a recording's tracker.raw");
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(path + ": cannot be opened for reading; check its permissions");
+  std::string data((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  if (in.bad()) throw InputError(path + ": read failed; check the file");
+  return data;
+}
+
+bool has_chunk_magic(const std::string& data) {
+  if (data.size() < 4) return false;
+  std::uint32_t magic = 0;
+  for (int i = 0; i < 4; ++i) magic |= std::uint32_t(std::uint8_t(data[i])) << (8 * i);
+  return magic == capture::kTrackerChunkMagic;
+}
+
+void run_decode(const DecodeOptions& o) {
+  tracking::TrackerFormat format;
+  try {
+    tracking::OutputFormat output;
+    output.output_list = tracking::parse_output_list(o.list);
+    if (o.units != "in" && o.units != "cm")
+      throw InputError("units '" + o.units + "' are unknown; use in (the device's default) or cm");
+    output.centimetres = o.units == "cm";
+    format = tracking::TrackerFormat::of(tracking::parse_device(o.device), o.binary, output);
+    tracking::validate_tracker_format(format);
+  } catch (const InputError& e) {
+    throw InputError(std::string("tracker decode: ") + e.what());
+  }
+  const std::string data = read_file(o.file);
+
+  std::vector<tracking::ByteChunk> chunks;
+  std::size_t torn_chunk_bytes = 0;
+  if (has_chunk_magic(data)) {
+    chunks = capture::parse_tracker_chunks(data, &torn_chunk_bytes);
+  } else {
+    chunks.push_back({0, std::vector<std::uint8_t>(data.begin(), data.end())});
+  }
+
+  tracking::DecodeCounts counts;
+  if (o.out.empty() || o.out == "-") {
+    counts = tracking::decode_to_csv(chunks, format, std::cout);
+    std::cout.flush();
+  } else {
+    // Whole or not at all: write beside the target and rename.
+    const std::string tmp = o.out + ".tmp";
+    {
+      std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
+      if (!out) throw InputError(o.out + ": cannot be created; check the folder exists and is writable");
+      counts = tracking::decode_to_csv(chunks, format, out);
+      out.close();
+      if (!out) {
+        std::filesystem::remove(tmp);
+        throw RuntimeError(o.out + ": write failed (disk full?); free space and retry");
+      }
+    }
+    std::error_code ec;
+    std::filesystem::rename(tmp, o.out, ec);
+    if (ec) {
+      std::filesystem::remove(tmp);
+      throw RuntimeError(o.out + ": cannot be put in place (" + ec.message() + ")");
+    }
+  }
+  std::string summary = o.file + ": " + tracking::decode_summary(counts);
+  if (torn_chunk_bytes > 0) summary += ", " + std::to_string(torn_chunk_bytes) + " bytes of a torn chunk ignored";
+  std::fprintf(stderr, "%s\n", summary.c_str());
+}
+
+}  // namespace
+
+void register_tracker_decode(CLI::App& tracker) {
+  auto o = std::make_shared<DecodeOptions>();
+  auto* cmd = tracker.add_subcommand("decode", "Decode raw tracker bytes (or a recording's tracker.raw) into CSV poses");
+  cmd->add_option("FILE", o->file, "Raw byte capture, or tracker.raw from a recording")->required();
+  // Values are checked when the command runs, so a bad one gets the usual one-line error.
+  cmd->add_option("--device", o->device, "Tracker model: isotrak2 or fastrak")->capture_default_str();
+  cmd->add_flag("--binary", o->binary, "Records are binary (`f` mode) instead of ASCII");
+  cmd->add_option("--units", o->units, "Position units the device sent: in or cm")->capture_default_str();
+  cmd->add_option("--list", o->list, "Output list the device was set to (`O` command), e.g. 2,4,1 or 2,11,1")
+      ->capture_default_str();
+  cmd->add_option("--out", o->out, "CSV file to write (default: standard output)");
+  add_action(cmd, [o] { run_decode(*o); });
+}
+
+}  // namespace lumar::app

@@ -1,0 +1,77 @@
+#include "output_files.h"
+
+#include <fmt/format.h>
+#include <opencv2/imgcodecs.hpp>
+
+#include "lumar/core/error.h"
+
+namespace lumar::app {
+
+namespace fs = std::filesystem;
+
+VideoOutput::VideoOutput(fs::path path, double fps, cv::Size size) : path_(std::move(path)) {
+  if (path_.extension() != ".mp4" && path_.extension() != ".mkv" && path_.extension() != ".avi")
+    throw InputError(path_.string() + ": output video must end in .mp4, .mkv or .avi");
+  if (!path_.parent_path().empty() && !fs::is_directory(path_.parent_path()))
+    throw InputError(path_.string() + ": folder " + path_.parent_path().string() + " does not exist");
+  // The partial file keeps the extension so that FFmpeg picks the same container.
+  partial_ = path_.parent_path() / ("." + path_.stem().string() + ".partial" + path_.extension().string());
+  // H.264 where the FFmpeg build has an encoder for it, else MPEG-4 part 2.
+  for (const char* fourcc : {"avc1", "mp4v"}) {
+    writer_.open(partial_.string(), cv::CAP_FFMPEG, cv::VideoWriter::fourcc(fourcc[0], fourcc[1], fourcc[2], fourcc[3]),
+                 fps, size);
+    if (writer_.isOpened()) {
+      codec_ = fourcc;
+      return;
+    }
+  }
+  throw RuntimeError(path_.string() + ": no video encoder available (tried H.264 and MPEG-4)");
+}
+
+VideoOutput::~VideoOutput() {
+  if (!committed_) {
+    writer_.release();
+    std::error_code ec;
+    fs::remove(partial_, ec);
+  }
+}
+
+void VideoOutput::write(const cv::Mat& bgr8) { writer_.write(bgr8); }
+
+void VideoOutput::commit() {
+  writer_.release();
+  std::error_code ec;
+  fs::rename(partial_, path_, ec);
+  if (ec) throw RuntimeError(path_.string() + ": cannot move the finished video into place (" + ec.message() + ")");
+  committed_ = true;
+}
+
+FramesOutput::FramesOutput(fs::path dir) : dir_(std::move(dir)) {
+  if (fs::exists(dir_)) throw InputError(dir_.string() + ": already exists; choose a new folder for the frames");
+  partial_ = dir_.parent_path() / ("." + dir_.filename().string() + ".partial");
+  std::error_code ec;
+  fs::remove_all(partial_, ec);
+  if (!fs::create_directories(partial_, ec) || ec)
+    throw InputError(dir_.string() + ": cannot create the folder (" + ec.message() + ")");
+}
+
+FramesOutput::~FramesOutput() {
+  if (!committed_) {
+    std::error_code ec;
+    fs::remove_all(partial_, ec);
+  }
+}
+
+void FramesOutput::write(std::int64_t index, const cv::Mat& bgr8) {
+  const fs::path file = partial_ / fmt::format("frame-{:06d}.png", index);
+  if (!cv::imwrite(file.string(), bgr8)) throw RuntimeError(file.string() + ": cannot write PNG");
+}
+
+void FramesOutput::commit() {
+  std::error_code ec;
+  fs::rename(partial_, dir_, ec);
+  if (ec) throw RuntimeError(dir_.string() + ": cannot move the frames into place (" + ec.message() + ")");
+  committed_ = true;
+}
+
+}  // namespace lumar::app

@@ -1,0 +1,37 @@
+#pragma once
+// Outputs that appear whole or not at all: everything is written under a temporary
+// name and renamed into place by commit(); without commit() the partial output is removed.
+#include <filesystem>
+#include <opencv2/core.hpp>
+#include <opencv2/videoio.hpp>
+
+namespace lumar::app {
+
+class VideoOutput {
+ public:
+  VideoOutput(std::filesystem::path path, double fps, cv::Size size);
+  ~VideoOutput();
+  void write(const cv::Mat& bgr8);
+  void commit();
+  const std::string& codec() const { return codec_; }
+
+ private:
+  std::filesystem::path path_, partial_;
+  cv::VideoWriter writer_;
+  std::string codec_;
+  bool committed_ = false;
+};
+
+class FramesOutput {
+ public:
+  explicit FramesOutput(std::filesystem::path dir);  // the folder must not exist yet
+  ~FramesOutput();
+  void write(std::int64_t index, const cv::Mat& bgr8);  // frame-000123.png
+  void commit();
+
+ private:
+  std::filesystem::path dir_, partial_;
+  bool committed_ = false;
+};
+
+}  // namespace lumar::app

@@ -1,0 +1,221 @@
+#include "synthetic_recording.h"
+
+#include <cmath>
+#include <opencv2/calib3d.hpp>
+#include <opencv2/imgproc.hpp>
+#include <spdlog/spdlog.h>
+
+#include "lumar/calib/undistortion.h"
+#include "lumar/capture/recording_writer.h"
+#include "lumar/capture/session.h"
+#include "lumar/core/color.h"
+#include "lumar/core/envmap.h"
+#include "lumar/core/error.h"
+#include "lumar/core/gl/context.h"
+#include "lumar/core/gl/renderer.h"
+#include "lumar/core/mesh.h"
+#include "lumar/core/scene.h"
+#include "lumar/tracking/isotrak_ascii.h"
+#include "lumar/tracking/pose_conversion.h"
+#include "lumar/tracking/simulated_tracker.h"
+#include "lumar/tracking/timestamping.h"
+
+namespace lumar::app {
+
+namespace {
+
+// OpenCV camera axes looking from `eye` at `target`, world +Y up.
+Pose look_at(const glm::dvec3& eye, const glm::dvec3& target) {
+  const glm::dvec3 forward = glm::normalize(target - eye);
+  const glm::dvec3 right = glm::normalize(glm::cross(forward, glm::dvec3(0, 1, 0)));
+  const glm::dvec3 down = glm::cross(forward, right);
+  Pose p;
+  p.rotation = glm::normalize(glm::quat_cast(glm::dmat3(right, down, forward)));
+  p.translation = eye;
+  return p;
+}
+
+// A pinhole camera, `supersample` times finer than `camera`, wide enough to cover
+// every ray of the distorted camera (barrel distortion sees past the pinhole frame).
+CameraIntrinsics covering_pinhole(const CameraIntrinsics& camera, int supersample) {
+  std::vector<cv::Point2f> border;
+  for (int x = 0; x < camera.width; x += 8) {
+    border.emplace_back(x, 0);
+    border.emplace_back(x, camera.height - 1);
+  }
+  for (int y = 0; y < camera.height; y += 8) {
+    border.emplace_back(0, y);
+    border.emplace_back(camera.width - 1, y);
+  }
+  border.emplace_back(camera.width - 1, camera.height - 1);
+  std::vector<cv::Point2f> normalized;
+  cv::undistortPoints(border, normalized, cv::Mat(camera.camera_matrix()), camera.distortion_coefficients());
+  float x0 = 0, x1 = 0, y0 = 0, y1 = 0;
+  for (const auto& p : normalized) {
+    x0 = std::min(x0, p.x), x1 = std::max(x1, p.x), y0 = std::min(y0, p.y), y1 = std::max(y1, p.y);
+  }
+  CameraIntrinsics pin;
+  const double s = supersample, pad = 4;  // pixels of the pinhole image beyond the rays
+  pin.fx = camera.fx * s;
+  pin.fy = camera.fy * s;
+  pin.cx = -x0 * pin.fx + pad;
+  pin.cy = -y0 * pin.fy + pad;
+  pin.width = int(std::ceil((x1 - x0) * pin.fx + 2 * pad));
+  pin.height = int(std::ceil((y1 - y0) * pin.fy + 2 * pad));
+  return pin;
+}
+
+// Radiance (linear, scene units) to an 8-bit frame as the camera would record it.
+cv::Mat expose(const cv::Mat& radiance_bgr, const CameraIntrinsics& camera, const SynthSettings& s,
+               double exposure, cv::RNG& rng) {
+  const double half_diagonal = 0.5 * std::hypot(camera.width, camera.height);
+  cv::Mat out(radiance_bgr.size(), CV_8UC3);
+  for (int y = 0; y < out.rows; ++y) {
+    const cv::Vec3f* in = radiance_bgr.ptr<cv::Vec3f>(y);
+    cv::Vec3b* o = out.ptr<cv::Vec3b>(y);
+    for (int x = 0; x < out.cols; ++x) {
+      const double r2 = (std::pow(x - camera.cx, 2) + std::pow(y - camera.cy, 2)) / (half_diagonal * half_diagonal);
+      const double gain = exposure * (1.0 + s.vignetting_a * r2 + s.vignetting_b * r2 * r2);
+      for (int c = 0; c < 3; ++c) {
+        const double signal = std::max(0.0, double(in[x][c]) * gain);
+        const double sigma = std::sqrt(s.shot_noise_gain * std::min(signal, 1.0) + s.read_noise * s.read_noise);
+        const double v = signal + rng.gaussian(sigma);
+        o[x][c] = cv::saturate_cast<uchar>(std::lround(linear_to_srgb(float(v)) * 255.0f));
+      }
+    }
+  }
+  return out;
+}
+
+// Where the camera looks: the foot of the first virtual object (the centre of its
+// world bounding box, at its lowest point), else the middle of the movement box.
+glm::dvec3 scene_target(const Scene& scene) {
+  if (scene.objects.empty()) return 0.5 * (scene.movement_min + scene.movement_max);
+  const SceneObject& object = scene.objects.front();
+  const auto [lo, hi] = transformed(load_mesh(object.mesh), object.T_world_model).bounds();
+  return {0.5 * (lo.x + hi.x), lo.y, 0.5 * (lo.z + hi.z)};
+}
+
+}  // namespace
+
+Pose orbit_camera_pose(const glm::dvec3& target, double s, double arc_deg) {
+  // An arc around the target that ends with the table block hiding part of the object,
+  // slowly descending, with a slight bob so motion is not planar.
+  const double start_deg = 100.0 - arc_deg;
+  const double az = glm::radians(start_deg + arc_deg * s);
+  const double radius = 1.55;
+  const double height = 1.25 - 0.15 * s + 0.03 * std::sin(6.0 * s);
+  const glm::dvec3 eye = target + glm::dvec3(radius * std::sin(az), 0.0, radius * std::cos(az)) +
+                         glm::dvec3(0, height - target.y, 0);
+  return look_at(eye, target + glm::dvec3(0, 0.08, 0));
+}
+
+void synthesize_recording(const SynthSettings& s) {
+  if (s.frames < 2) throw InputError("--frames: need at least 2 frames");
+  if (s.fps <= 0) throw InputError("--fps: must be positive");
+  if (std::filesystem::exists(s.out))
+    throw InputError(s.out.string() + ": already exists; choose a new recording directory");
+  const Scene scene = load_scene(s.scene);
+  EnvironmentMap map = load_environment_map(scene.environment_map);
+  map.capture_position = scene.capture_position;
+  map.azimuth_offset_deg = scene.azimuth_offset_deg;
+  if (scene.room_mesh.empty()) throw InputError(s.scene.string() + ": synth needs a proxy room (room.mesh)");
+  const Mesh room = transformed(load_mesh(scene.room_mesh), glm::dmat4(glm::dmat3(scene.room_scale)));
+
+  auto context = gl::create_headless_context();
+  const CameraIntrinsics pinhole = covering_pinhole(s.camera, s.supersample);
+  gl::Renderer renderer(pinhole);
+  renderer.set_room(room);
+  renderer.set_environment(map);
+
+  // The rig: transmitter on the table, +Z (Polhemus down) along world -Y; the sensor
+  // clipped to the camera a few centimetres away, turned 90 degrees.
+  capture::Session session;
+  session.camera = s.camera;
+  session.rig.T_world_transmitter = Pose{axis_angle_deg({1, 0, 0}, 90), {0.85, 0.72, -0.75}};
+  session.rig.T_sensor_camera = Pose{axis_angle_deg({0, 0, 1}, 90), {0.03, 0.05, -0.02}};
+  session.rig.latency = seconds_to_nanos(s.latency_ms * 1e-3);
+  session.scene =
+      std::filesystem::relative(std::filesystem::absolute(s.scene), std::filesystem::absolute(s.out)).string();
+  session.extra["source"] = "lumar synth";
+  session.extra["synth"] = {{"frames", s.frames},          {"fps", s.fps},
+                            {"tracker_noise_deg", s.tracker_noise_deg},
+                            {"position_noise_m", s.position_noise_m},
+                            {"read_noise", s.read_noise},  {"shot_noise_gain", s.shot_noise_gain},
+                            {"arc_deg", s.arc_deg},        {"seed", s.seed}};
+
+  const glm::dvec3 target = scene_target(scene);
+  const Nanos start = seconds_to_nanos(0.1);  // tracker runs before the first frame
+  const Nanos frame_period = seconds_to_nanos(1.0 / s.fps);
+  const Nanos duration = start + frame_period * s.frames + seconds_to_nanos(0.1);
+  const double clip_seconds = nanos_to_seconds(frame_period * (s.frames - 1));
+  auto true_camera = [&](Nanos t) {
+    const double u = std::clamp(nanos_to_seconds(t - start) / clip_seconds, 0.0, 1.0);
+    return orbit_camera_pose(target, u, s.arc_deg);
+  };
+
+  tracking::SimulatedTrackerSettings ts;
+  ts.rate_hz = session.tracker.rate_hz;
+  ts.baud = session.tracker.baud;
+  ts.device_latency = session.rig.latency;
+  ts.orientation_noise_deg = s.tracker_noise_deg;
+  ts.position_noise_m = s.position_noise_m;
+  ts.seed = s.seed;
+  ts.station = session.tracker.station;
+  const auto tracker = tracking::simulate_tracker(
+      [&](Nanos t) { return session.rig.sensor_pose(true_camera(t)); }, duration, ts);
+
+  // Exposure: the first view's mean radiance becomes 18 % grey unless given.
+  double exposure = s.exposure;
+  if (exposure <= 0) {
+    const cv::Mat first = renderer.render_room_radiance(pinhole, true_camera(start));
+    const cv::Scalar mean = cv::mean(first);
+    const double luminance = 0.0722 * mean[0] + 0.7152 * mean[1] + 0.2126 * mean[2];
+    if (!(luminance > 0)) throw InputError(s.scene.string() + ": the first view of the room is black");
+    exposure = 0.18 / luminance;
+  }
+  session.radiometry.exposure = exposure;
+  session.radiometry.vignetting_a = s.vignetting_a;
+  session.radiometry.vignetting_b = s.vignetting_b;
+
+  capture::RecordingSettings rs;
+  rs.codec = s.codec;
+  rs.quality = s.quality;
+  rs.fps = s.fps;
+  rs.size = cv::Size(s.camera.width, s.camera.height);
+  try {
+    capture::RecordingWriter writer(s.out, capture::session_to_json(session), rs);
+    // The tracker's bytes as they arrived, and the poses the real parser decodes from them.
+    tracking::OutputFormat format;
+    format.output_list = session.tracker.output_list;
+    tracking::AsciiRecordParser parser(format, 2, ts.baud);
+    for (const auto& chunk : tracker.chunks) {
+      writer.add_tracker_bytes(chunk);
+      parser.push(chunk);
+      for (const auto& r : parser.take_all()) {
+        const Nanos t = tracking::measurement_time(r.first_byte_arrival, ts.baud, session.rig.latency);
+        if (auto sample = tracking::to_pose_sample(r.record, format, t)) writer.add_pose(*sample);
+      }
+    }
+    cv::RNG rng(s.seed);
+    for (int k = 0; k < s.frames; ++k) {
+      const Nanos t = start + frame_period * k;
+      const Pose T_world_camera = true_camera(t);
+      const cv::Mat radiance = renderer.render_room_radiance(pinhole, T_world_camera);
+      const cv::Mat distorted = calib::distort_image(radiance, pinhole, s.camera);
+      capture::Frame frame{expose(distorted, s.camera, s, exposure, rng), t, k};
+      writer.add_frame(frame);
+      writer.add_truth(k, t, T_world_camera);
+      if ((k + 1) % 12 == 0 || k + 1 == s.frames) spdlog::info("synth: frame {}/{}", k + 1, s.frames);
+    }
+    writer.close();
+  } catch (...) {
+    std::error_code ec;
+    std::filesystem::remove_all(s.out, ec);
+    throw;
+  }
+  spdlog::info("synth: wrote {} ({} frames, exposure {:.4g}, tracker {} records)", s.out.string(), s.frames,
+               exposure, tracker.noisy_samples.size());
+}
+
+}  // namespace lumar::app

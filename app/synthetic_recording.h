@@ -1,0 +1,42 @@
+#pragma once
+// `lumar synth`: renders a recording whose truth is known. The proxy room is textured
+// by projecting the HDR map from its capture point, seen by the calibrated camera
+// (lens distortion, vignetting, sensor noise, 8-bit clipping) along a trajectory, with
+// the byte stream a Polhemus ISOTRAK II would send about the same motion.
+#include <cstdint>
+#include <filesystem>
+#include <string>
+
+#include "lumar/core/camera.h"
+#include "lumar/core/pose.h"
+
+namespace lumar::app {
+
+struct SynthSettings {
+  std::filesystem::path scene;
+  std::filesystem::path out;
+  CameraIntrinsics camera;  // calibrated, with distortion
+  int frames = 48;
+  double fps = 24.0;
+  int supersample = 2;
+  double exposure = 0.0;             // video linear value per unit radiance; 0 = automatic
+  double read_noise = 0.002;         // linear units, standard deviation
+  double shot_noise_gain = 0.0004;   // variance per unit of linear signal
+  double vignetting_a = -0.30, vignetting_b = 0.05;
+  double tracker_noise_deg = 0.75;   // RMS rotation error
+  double position_noise_m = 0.0025;  // RMS per axis
+  double latency_ms = 20.0;          // device latency
+  double arc_deg = 60.0;             // how far the camera orbits
+  std::string codec = "mjpeg";
+  int quality = 95;
+  std::uint64_t seed = 1;
+};
+
+// The camera's true pose at s in [0, 1] along the orbit around `target`.
+Pose orbit_camera_pose(const glm::dvec3& target, double s, double arc_deg);
+
+// Writes the recording into settings.out (which must not exist yet). Throws
+// InputError / RuntimeError; on failure the partial recording directory is removed.
+void synthesize_recording(const SynthSettings& settings);
+
+}  // namespace lumar::app

@@ -1,0 +1,134 @@
+#include "bench_report.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <fmt/format.h>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+namespace lumar::bench {
+
+void BenchReport::compute_ratios() {
+  double base = 0;
+  for (const auto& e : entries)
+    if (e.name == baseline) base = e.time_ms;
+  for (auto& e : entries) e.ratio = base > 0 ? e.time_ms / base : 0.0;
+}
+
+void BenchReport::write_json(const std::filesystem::path& file) const {
+  nlohmann::json j = {{"name", name}, {"title", title}, {"baseline", baseline}, {"error_label", error_label}};
+  for (const auto& e : entries) {
+    nlohmann::json row = {{"name", e.name}, {"time_ms", e.time_ms}, {"ratio_to_baseline", e.ratio}};
+    if (!std::isnan(e.error)) row["error"] = e.error;
+    j["entries"].push_back(row);
+  }
+  const auto tmp = file.string() + ".tmp";
+  std::ofstream(tmp) << j.dump(2) << "\n";
+  std::filesystem::rename(tmp, file);
+}
+
+namespace {
+
+const cv::Scalar kInk(40, 40, 40), kGrid(225, 225, 225), kBar(180, 120, 60), kDot(40, 90, 200);
+
+void text(cv::Mat& img, const std::string& s, cv::Point at, double scale = 0.45, cv::Scalar colour = kInk) {
+  cv::putText(img, s, at, cv::FONT_HERSHEY_SIMPLEX, scale, colour, 1, cv::LINE_AA);
+}
+
+std::string short_number(double v) { return fmt::format("{:.3g}", v); }
+
+}  // namespace
+
+void BenchReport::write_chart(const std::filesystem::path& file) const {
+  const bool tradeoff = std::any_of(entries.begin(), entries.end(), [](const auto& e) { return !std::isnan(e.error); });
+  const int W = 900, H = tradeoff ? 560 : 120 + 34 * int(entries.size());
+  cv::Mat img(H, W, CV_8UC3, cv::Scalar(255, 255, 255));
+  text(img, title, {20, 30}, 0.6);
+  if (!tradeoff) {
+    // Horizontal bars: one per entry, time in ms, ratio to the baseline after it.
+    const int left = 260, right = W - 170, top = 60;
+    double tmax = 0;
+    for (const auto& e : entries) tmax = std::max(tmax, e.time_ms);
+    for (std::size_t i = 0; i < entries.size(); ++i) {
+      const auto& e = entries[i];
+      const int y = top + 34 * int(i);
+      const int len = tmax > 0 ? int((right - left) * e.time_ms / tmax) : 0;
+      text(img, e.name, {20, y + 18});
+      cv::rectangle(img, {left, y + 4}, {left + std::max(1, len), y + 24}, e.name == baseline ? kDot : kBar, cv::FILLED);
+      text(img, fmt::format("{} ms  x{:.2f}", short_number(e.time_ms), e.ratio), {left + len + 8, y + 19});
+    }
+    text(img, fmt::format("ratios against '{}' measured in the same run", baseline), {20, H - 20}, 0.42);
+  } else {
+    // Error against time, both on log axes; each point labelled.
+    const int left = 90, right = W - 40, top = 60, bottom = H - 70;
+    double t0 = 1e300, t1 = 0, e0 = 1e300, e1 = 0;
+    for (const auto& e : entries) {
+      if (std::isnan(e.error)) continue;
+      t0 = std::min(t0, e.time_ms), t1 = std::max(t1, e.time_ms);
+      e0 = std::min(e0, std::max(e.error, 1e-6)), e1 = std::max(e1, std::max(e.error, 1e-6));
+    }
+    const double lt0 = std::floor(std::log10(t0)), lt1 = std::ceil(std::log10(t1)) + (t1 == t0 ? 1 : 0);
+    const double le0 = std::floor(std::log10(e0)), le1 = std::ceil(std::log10(e1)) + (e1 == e0 ? 1 : 0);
+    auto px = [&](double t) { return left + int((right - left) * (std::log10(t) - lt0) / (lt1 - lt0)); };
+    auto py = [&](double e) { return bottom - int((bottom - top) * (std::log10(std::max(e, 1e-6)) - le0) / (le1 - le0)); };
+    for (double d = lt0; d <= lt1; d += 1) {
+      cv::line(img, {px(std::pow(10, d)), top}, {px(std::pow(10, d)), bottom}, kGrid);
+      text(img, short_number(std::pow(10, d)), {px(std::pow(10, d)) - 12, bottom + 20}, 0.4);
+    }
+    for (double d = le0; d <= le1; d += 1) {
+      cv::line(img, {left, py(std::pow(10, d))}, {right, py(std::pow(10, d))}, kGrid);
+      text(img, short_number(std::pow(10, d)), {10, py(std::pow(10, d)) + 5}, 0.4);
+    }
+    cv::rectangle(img, {left, top}, {right, bottom}, kInk);
+    text(img, "time per operation (ms, log)", {(left + right) / 2 - 100, H - 25});
+    text(img, error_label + " (log)", {left, top - 10}, 0.42);
+    for (const auto& e : entries) {
+      if (std::isnan(e.error)) continue;
+      const cv::Point p(px(e.time_ms), py(e.error));
+      cv::circle(img, p, 5, e.name == baseline ? kBar : kDot, cv::FILLED, cv::LINE_AA);
+      text(img, e.name, p + cv::Point(8, -6), 0.4);
+    }
+  }
+  const auto tmp = file.parent_path() / (".tmp-" + file.filename().string());
+  cv::imwrite(tmp.string(), img);
+  std::filesystem::rename(tmp, file);
+}
+
+void BenchReport::save(const std::filesystem::path& dir) const {
+  std::filesystem::create_directories(dir);
+  write_json(dir / (name + ".json"));
+  write_chart(dir / (name + ".png"));
+  std::printf("\n%s\n%-34s %12s %10s %14s\n", title.c_str(), "entry", "ms/op", "x baseline",
+              error_label.empty() ? "" : "error");
+  for (const auto& e : entries)
+    std::printf("%-34s %12.4g %10.3f %14s\n", e.name.c_str(), e.time_ms, e.ratio,
+                std::isnan(e.error) ? "" : fmt::format("{:.4g}", e.error).c_str());
+  std::printf("-> %s/%s.{json,png}\n", dir.c_str(), name.c_str());
+}
+
+std::filesystem::path results_dir() {
+  if (const char* env = std::getenv("LUMAR_BENCH_OUT")) return env;
+  return std::filesystem::path(LUMAR_SOURCE_DIR) / "bench" / "results";
+}
+
+}  // namespace lumar::bench
+
+namespace lumar::bench {
+
+void CollectingReporter::ReportRuns(const std::vector<Run>& runs) {
+  benchmark::ConsoleReporter::ReportRuns(runs);
+  for (const Run& run : runs) {
+    if (run.run_type != Run::RT_Iteration || run.error_occurred) continue;
+    Result r;
+    const double to_ms = 1e3 / benchmark::GetTimeUnitMultiplier(run.time_unit);
+    r.time_ms = run.GetAdjustedRealTime() * to_ms;
+    for (const auto& [k, c] : run.counters) r.counters[k] = c.value;
+    results_[run.benchmark_name()] = r;
+  }
+}
+
+}  // namespace lumar::bench

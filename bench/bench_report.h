@@ -1,0 +1,60 @@
+#pragma once
+// The common way benchmarks record results: entries with a time, optionally an error
+// against a reference, and a ratio to a baseline measured in the same run; written as
+// JSON and drawn as a PNG chart (bars of time, or time against error).
+#include <filesystem>
+#include <limits>
+#include <string>
+#include <vector>
+
+namespace lumar::bench {
+
+struct BenchEntry {
+  std::string name;
+  double time_ms = 0;                                       // per operation
+  double error = std::numeric_limits<double>::quiet_NaN();  // against the reference; NaN = not measured
+  double ratio = 0;                                         // time_ms / baseline time_ms
+};
+
+struct BenchReport {
+  std::string name;          // file stem: bench/results/<name>.json and .png
+  std::string title;
+  std::string baseline;      // entry whose time every ratio divides by
+  std::string error_label;   // what `error` measures, e.g. "mean relative irradiance error (%)"
+  std::vector<BenchEntry> entries;
+
+  void compute_ratios();
+  void write_json(const std::filesystem::path& file) const;
+  // Bars of time per entry (ratio printed beside), or, when entries carry errors, a
+  // scatter of error against time on log axes: the speed/accuracy chart.
+  void write_chart(const std::filesystem::path& file) const;
+  // Writes <dir>/<name>.json and <dir>/<name>.png and prints a table.
+  void save(const std::filesystem::path& dir) const;
+};
+
+// Where results go: $LUMAR_BENCH_OUT, else bench/results in the source tree.
+std::filesystem::path results_dir();
+
+}  // namespace lumar::bench
+
+#include <benchmark/benchmark.h>
+#include <map>
+
+namespace lumar::bench {
+
+// Console output as usual, and every run's time (ms per iteration) and counters kept
+// for the report.
+class CollectingReporter : public benchmark::ConsoleReporter {
+ public:
+  struct Result {
+    double time_ms = 0;
+    std::map<std::string, double> counters;
+  };
+  void ReportRuns(const std::vector<Run>& runs) override;
+  const std::map<std::string, Result>& results() const { return results_; }
+
+ private:
+  std::map<std::string, Result> results_;
+};
+
+}  // namespace lumar::bench

@@ -1,0 +1,46 @@
+#pragma once
+// Replays a recording as the live system would see it: frames from the video, camera
+// poses from the raw tracker bytes run through the real protocol parser, time-aligned
+// with the rig's latency. Ground truth, where the recording has it, sits beside.
+#include <filesystem>
+#include <memory>
+#include <optional>
+
+#include "lumar/capture/frame_source.h"
+#include "lumar/capture/recording_reader.h"
+#include "lumar/capture/session.h"
+#include "lumar/tracking/pose_stream.h"
+
+namespace lumar::capture {
+
+struct TrackerReplayStats {
+  std::size_t records = 0, rejected_records = 0, skipped_bytes = 0, torn_bytes = 0;
+};
+
+class RecordingReplay {
+ public:
+  // Throws InputError naming the file when the recording or its session is unusable.
+  explicit RecordingReplay(const std::filesystem::path& dir);
+
+  const RecordingReader& reader() const { return reader_; }
+  const Session& session() const { return session_; }
+  // The scene manifest named by the session, resolved against the recording (empty if none).
+  std::filesystem::path scene_path() const;
+  std::unique_ptr<FrameSource> open_frames() const { return reader_.open_frames(); }
+
+  // T_world_camera from the tracker at time t (recording time); nullopt where the tracker
+  // stream does not cover t.
+  std::optional<Pose> tracked_camera_pose(Nanos t) const;
+  // True T_world_camera of frame `index`, where the recording has ground truth.
+  std::optional<Pose> true_camera_pose(std::int64_t index) const;
+  const TrackerReplayStats& tracker_stats() const { return stats_; }
+
+ private:
+  RecordingReader reader_;
+  Session session_;
+  tracking::PoseStream poses_;
+  std::vector<TruthEntry> truth_;
+  TrackerReplayStats stats_;
+};
+
+}  // namespace lumar::capture

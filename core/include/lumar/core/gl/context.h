@@ -1,0 +1,50 @@
+#pragma once
+// OpenGL 4.5 core contexts. The renderer does not care where its context comes from:
+// a surfaceless EGL context (offline rendering, tests, no X server) or a GLFW window
+// (the interactive viewer). GL objects belong to the context that was current when
+// they were made; destroy them while it is current again.
+#include <memory>
+#include <opencv2/core.hpp>
+#include <string>
+
+namespace lumar::gl {
+
+class Context {
+ public:
+  virtual ~Context() = default;
+  virtual void make_current() = 0;
+  virtual std::string renderer_name() const = 0;  // GL_RENDERER + GL_VERSION
+};
+
+// EGL on Mesa's surfaceless platform (EGL_MESA_platform_surfaceless), OpenGL 4.5 core,
+// current on the calling thread when returned. Needs no X server (works with DISPLAY
+// unset); render into framebuffer objects. Throws RuntimeError when EGL or GL 4.5 is
+// unavailable.
+std::unique_ptr<Context> create_headless_context();
+
+// A GLFW window with an OpenGL 4.5 core context, current on the calling thread when
+// constructed. Throws RuntimeError when no display can be opened.
+class WindowContext : public Context {
+ public:
+  WindowContext(int width, int height, const std::string& title);
+  ~WindowContext() override;
+  WindowContext(const WindowContext&) = delete;
+  WindowContext& operator=(const WindowContext&) = delete;
+
+  void make_current() override;
+  std::string renderer_name() const override;
+  bool should_close() const;
+  void poll_events();
+  // Draws a BGR8 image (top row first) over the whole window, scaled if the sizes
+  // differ, and swaps buffers.
+  void present(const cv::Mat& bgr8);
+  // What the window shows after the last present(), as the X server has it (for tests),
+  // BGR8, top row first.
+  cv::Mat read_front_buffer();
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace lumar::gl

@@ -1,0 +1,46 @@
+#include "gl/gpu_mesh.h"
+
+#include <string>
+
+#include "lumar/core/error.h"
+
+namespace lumar::gl {
+
+GpuMesh::GpuMesh(const Mesh& mesh, const char* what) {
+  if (mesh.indices.size() % 3 != 0)
+    throw InputError(std::string(what) + ": index count is not a multiple of three; pass whole triangles");
+  if (!mesh.normals.empty() && mesh.normals.size() != mesh.positions.size())
+    throw InputError(std::string(what) + ": " + std::to_string(mesh.normals.size()) + " normals for " +
+                     std::to_string(mesh.positions.size()) + " positions; give one normal per vertex");
+  for (std::uint32_t i : mesh.indices)
+    if (i >= mesh.positions.size())
+      throw InputError(std::string(what) + ": vertex index " + std::to_string(i) + " out of range (" +
+                       std::to_string(mesh.positions.size()) + " vertices); the mesh is corrupt");
+  if (mesh.indices.empty()) return;
+
+  vertex_array_ = create_vertex_array();
+  const GLuint vao = vertex_array_.get();
+  positions_ = create_buffer(mesh.positions.data(), mesh.positions.size() * sizeof(glm::vec3));
+  glVertexArrayVertexBuffer(vao, 0, positions_.get(), 0, sizeof(glm::vec3));
+  glVertexArrayAttribFormat(vao, 0, 3, GL_FLOAT, GL_FALSE, 0);
+  glVertexArrayAttribBinding(vao, 0, 0);
+  glEnableVertexArrayAttrib(vao, 0);
+  if (!mesh.normals.empty()) {
+    normals_ = create_buffer(mesh.normals.data(), mesh.normals.size() * sizeof(glm::vec3));
+    glVertexArrayVertexBuffer(vao, 1, normals_.get(), 0, sizeof(glm::vec3));
+    glVertexArrayAttribFormat(vao, 1, 3, GL_FLOAT, GL_FALSE, 0);
+    glVertexArrayAttribBinding(vao, 1, 1);
+    glEnableVertexArrayAttrib(vao, 1);
+  }
+  indices_ = create_buffer(mesh.indices.data(), mesh.indices.size() * sizeof(std::uint32_t));
+  glVertexArrayElementBuffer(vao, indices_.get());
+  index_count_ = GLsizei(mesh.indices.size());
+}
+
+void GpuMesh::draw() const {
+  if (empty()) return;
+  glBindVertexArray(vertex_array_.get());
+  glDrawElements(GL_TRIANGLES, index_count_, GL_UNSIGNED_INT, nullptr);
+}
+
+}  // namespace lumar::gl

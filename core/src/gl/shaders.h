@@ -1,0 +1,20 @@
+#pragma once
+// GLSL sources of the renderer (shaders.cpp). Uniforms are set by name; samplers
+// have fixed texture units (layout(binding = N)), named below.
+namespace lumar::gl::shaders {
+
+// Vertex stages.
+extern const char* const kFullscreenVertex;  // one triangle covering the viewport
+extern const char* const kMeshVertex;        // model -> world -> clip; world position and normal out
+
+// Fragment stages.
+extern const char* const kBackgroundFragment;     // undistorted video, decoded to linear
+extern const char* const kDepthOnlyFragment;      // proxy room as occluder
+extern const char* const kShadedObjectFragment;   // albedo * E(n) / pi * exposure, E from SH9
+extern const char* const kWorldPositionFragment;  // (x, y, z, 1)
+extern const char* const kRoomRadianceFragment;   // environment map projected from its capture point
+extern const char* const kEncodeFragment;         // linear -> sRGB, rows flipped for read-back
+
+constexpr int kVideoUnit = 0, kUndistortionMapUnit = 1, kEnvironmentUnit = 2, kLinearImageUnit = 3;
+
+}  // namespace lumar::gl::shaders

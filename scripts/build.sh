@@ -1,0 +1,16 @@
+#!/usr/bin/env bash
+# Configures and builds Lumar. Usage: scripts/build.sh [release|asan|tsan]
+# The build goes to build/<type>/ inside the checkout.
+set -euo pipefail
+top=$(cd "$(dirname "$0")/.." && pwd)
+type=${1:-release}
+case "$type" in
+  release) cmake_type=Release ;;
+  asan) cmake_type=Asan ;;
+  tsan) cmake_type=Tsan ;;
+  *) echo "build.sh: unknown build type '$type' (release, asan or tsan)" >&2; exit 2 ;;
+esac
+build="$top/build/$type"
+cmake -S "$top" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE="$cmake_type" -DLUMAR_SHARED_DIR="$top/../shared" >/dev/null
+cmake --build "$build" -j"$(nproc)"
+echo "build.sh: built $build"

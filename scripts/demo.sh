@@ -1,0 +1,12 @@
+#!/usr/bin/env bash
+# Installs what is missing, builds Lumar (Release) and composites the figurine into the
+# bundled sample recording. Writes out/demo.mp4 and out/demo-frames/*.png.
+set -euo pipefail
+top=$(cd "$(dirname "$0")/.." && pwd)
+bash "$top/scripts/install-deps.sh"
+bash "$top/scripts/build.sh" release
+lumar="$top/build/release/app/lumar"
+mkdir -p "$top/out"
+rm -rf "$top/out/demo.mp4" "$top/out/demo-frames"
+"$lumar" overlay --recording "$top/recordings/orbit" --out "$top/out/demo.mp4" --frames-dir "$top/out/demo-frames"
+echo "demo: wrote $top/out/demo.mp4 and $top/out/demo-frames/"

@@ -1,0 +1,39 @@
+# Helpers for the command-line tests. Each test script defines functions named
+# case_<name>; CTest runs one case per test: bash script.sh LUMAR SOURCE SHARED CASE.
+set -uo pipefail
+LUMAR=$1
+SRC=$2
+SHARED=$3
+CASE=$4
+TMP=$(mktemp -d "${TMPDIR:-/tmp}/lumar-cli-XXXXXX")
+trap 'rm -rf "$TMP"' EXIT
+unset DISPLAY  # headless unless a case asks for a display
+
+fail() { echo "FAIL: $*" >&2; exit 1; }
+
+# expect_bad_input WHAT_STDERR_MUST_NAME OUTPUT_THAT_MUST_NOT_EXIST -- command...
+# The command must exit 2 with exactly one line on stderr that names the file, and
+# leave no output (nor a partial one) behind.
+expect_bad_input() {
+  local must_name=$1 output=$2
+  shift 3
+  "$@" >"$TMP/stdout" 2>"$TMP/stderr"
+  local status=$?
+  [ $status -eq 2 ] || { cat "$TMP/stderr" >&2; fail "exit status $status, expected 2: $*"; }
+  local lines
+  lines=$(grep -c . "$TMP/stderr")
+  [ "$lines" -eq 1 ] || { cat "$TMP/stderr" >&2; fail "expected one line on stderr, got $lines"; }
+  grep -qF -- "$must_name" "$TMP/stderr" || { cat "$TMP/stderr" >&2; fail "stderr does not name $must_name"; }
+  if [ -n "$output" ]; then
+    [ ! -e "$output" ] || fail "output $output was left behind"
+    local partials
+    partials=$(find "$(dirname "$output")" -maxdepth 1 -name '.*partial*' | wc -l)
+    [ "$partials" -eq 0 ] || fail "a partial output was left behind in $(dirname "$output")"
+  fi
+  echo "ok: $(head -1 "$TMP/stderr")"
+}
+
+run_case() {
+  declare -F "case_$CASE" >/dev/null || fail "no case '$CASE' in $0"
+  "case_$CASE"
+}

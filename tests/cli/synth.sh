@@ -1,0 +1,26 @@
+# lumar synth makes a recording whose truth the overlay and regression recover.
+source "$(dirname "$0")/lib.sh"
+SCENE=$SRC/data/scenes/room/scene.json
+CAM=$SRC/data/camera/webcam-640x480.yml
+
+case_synth_then_regress() {
+  "$LUMAR" synth --scene "$SCENE" --camera "$CAM" --out "$TMP/rec" --frames 6 --fps 12 --supersample 1 \
+    >"$TMP/log" 2>&1 || { cat "$TMP/log"; fail "synth failed"; }
+  for f in session.json frames.csv tracker.raw poses.csv truth.csv; do
+    [ -s "$TMP/rec/$f" ] || fail "synth wrote no $f"
+  done
+  [ "$(grep -c '^[0-9]' "$TMP/rec/frames.csv")" -eq 6 ] || fail "expected 6 frames in frames.csv"
+  [ "$(grep -c '^[0-9]' "$TMP/rec/truth.csv")" -eq 6 ] || fail "expected 6 true poses"
+  "$LUMAR" regress --update "$TMP/rec" || fail "regress --update failed"
+  "$LUMAR" regress "$TMP/rec" | tee "$TMP/regress" || fail "regress on a fresh synthetic recording failed"
+}
+
+case_synth_refuses_existing_output() {
+  mkdir -p "$TMP/rec"
+  touch "$TMP/rec/keep-me"
+  "$LUMAR" synth --scene "$SCENE" --camera "$CAM" --out "$TMP/rec" --frames 2 2>"$TMP/err"
+  [ $? -eq 2 ] || fail "expected exit status 2"
+  [ -e "$TMP/rec/keep-me" ] || fail "synth touched an existing folder"
+}
+
+run_case

@@ -1,0 +1,39 @@
+#pragma once
+// Shared pieces of the renderer tests: one headless context per process, meshes built
+// in code (so the tests need no files), camera poses.
+#include <opencv2/core.hpp>
+
+#include "lumar/core/camera.h"
+#include "lumar/core/gl/context.h"
+#include "lumar/core/mesh.h"
+#include "lumar/core/pose.h"
+#include "lumar/core/sh.h"
+
+namespace lumar::test {
+
+// A surfaceless EGL context, made current; created on first use, kept for the process.
+gl::Context& headless_context();
+
+// Closed UV sphere with outward unit normals.
+Mesh make_sphere(const glm::vec3& centre, float radius, int slices, int stacks);
+// Axis-aligned box, 12 triangles, flat face normals pointing outward (inward if `inward`).
+Mesh make_box(const glm::vec3& min, const glm::vec3& max, bool inward = false);
+// A rectangle through `centre` spanned by half-extents `a` and `b`; all four vertex
+// normals are `normal` (need not match the geometry: the shading tests choose it freely).
+Mesh make_quad(const glm::vec3& centre, const glm::vec3& a, const glm::vec3& b, const glm::vec3& normal);
+
+// OpenCV camera at `eye` looking at `target` (+Y world up), rolled by `roll_deg` about its view axis.
+Pose look_at(const glm::dvec3& eye, const glm::dvec3& target, double roll_deg = 0.0);
+
+// OpenCV rvec / tvec of T_camera_world for cv::projectPoints.
+void rvec_tvec(const Pose& T_world_camera, cv::Mat& rvec, cv::Mat& tvec);
+
+// Real SH basis in world coordinates, order L00, L1-1(y), L10(z), L11(x), L2-2(xy),
+// L2-1(yz), L20(3z^2-1), L21(xz), L22(x^2-y^2).
+std::array<double, 9> sh_basis(const glm::dvec3& d);
+// Ramamoorthi & Hanrahan irradiance from nine coefficients (CPU reference), not clamped.
+glm::dvec3 sh_irradiance_reference(const SH9& sh, const glm::dvec3& n);
+
+CameraIntrinsics make_camera(int w, int h, double fx, double fy, double cx, double cy);
+
+}  // namespace lumar::test

@@ -1,0 +1,77 @@
+#pragma once
+// The One Euro filter (Casiez, Roussel, Vogel, CHI 2012) for tracker poses: a first-
+// order low-pass whose cutoff rises with speed, so a still camera is smoothed hard
+// (little jitter) and a moving one lightly (little lag).
+//
+//   a(fc, dt) = r / (1 + r), r = 2 pi fc dt
+//   v         = low-pass of (x - x_hat_prev) / dt with cutoff d_cutoff
+//   fc        = min_cutoff + beta * |v|
+//   x_hat     = x_hat_prev + a(fc, dt) (x - x_hat_prev)
+//
+// Position: x is the translation in metres, v in m/s, beta in Hz per m/s. Rotation:
+// v is the angular velocity in rad/s (the rotation vector from the previous output to
+// the new sample over dt), beta in Hz per rad/s, and the update is a slerp from the
+// previous output toward the sample by a, on the shortest path; never Euler angles.
+// The velocity is low-passed as a vector and only then its norm taken, so noise at
+// rest averages out instead of raising the cutoff of a still camera.
+// With beta = 0 both are plain exponential smoothing with cutoff min_cutoff.
+#include <map>
+#include <optional>
+
+#include "lumar/core/pose.h"
+#include "lumar/core/time.h"
+#include "lumar/tracking/pose_sample.h"
+
+namespace lumar::tracking {
+
+struct OneEuroSettings {
+  double min_cutoff_hz = 1.0;  // cutoff at rest: lower = less jitter, more lag
+  double beta = 0.0;           // cutoff increase per unit of speed (Hz per m/s or per rad/s)
+  double d_cutoff_hz = 1.0;    // cutoff of the speed estimate
+};
+
+// Throws InputError naming `what` unless the cutoffs are finite and > 0 and beta is
+// finite and >= 0.
+void validate_one_euro(const OneEuroSettings& settings, const char* what);
+
+struct PoseFilterSettings {
+  OneEuroSettings position{1.0, 1.0, 1.0};   // beta in Hz per m/s
+  OneEuroSettings rotation{1.0, 0.5, 1.0};   // beta in Hz per rad/s
+};
+
+// Filters one station's poses. The first pose passes through unchanged; a pose whose
+// time is not after the previous one returns the previous output unchanged.
+class OneEuroPoseFilter {
+ public:
+  explicit OneEuroPoseFilter(PoseFilterSettings settings = {});
+
+  Pose filter(const Pose& pose, Nanos time);
+  void reset() { state_.reset(); }
+  const PoseFilterSettings& settings() const { return settings_; }
+
+ private:
+  struct State {
+    Nanos time = 0;
+    Pose out;
+    glm::dvec3 velocity{0.0};          // filtered, m/s
+    glm::dvec3 angular_velocity{0.0};  // filtered, rad/s (transmitter frame)
+  };
+  PoseFilterSettings settings_;
+  std::optional<State> state_;
+};
+
+// One OneEuroPoseFilter per station, for a stream of samples from several stations.
+class PoseSampleFilter {
+ public:
+  explicit PoseSampleFilter(PoseFilterSettings settings = {}) : settings_(settings) {
+    validate_one_euro(settings.position, "position filter");
+    validate_one_euro(settings.rotation, "rotation filter");
+  }
+  PoseSample filter(PoseSample sample);
+
+ private:
+  PoseFilterSettings settings_;
+  std::map<int, OneEuroPoseFilter> by_station_;
+};
+
+}  // namespace lumar::tracking

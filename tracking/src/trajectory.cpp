@@ -1,0 +1,129 @@
+#include "lumar/tracking/trajectory.h"
+
+#include <charconv>
+#include <cmath>
+#include <fstream>
+#include <map>
+#include <memory>
+#include <numbers>
+#include <sstream>
+
+#include "lumar/core/error.h"
+#include "lumar/tracking/pose_stream.h"
+
+namespace lumar::tracking {
+
+namespace {
+
+constexpr double kTwoPi = 2.0 * std::numbers::pi;
+
+glm::dvec3 station_base(int station) { return {0.30, 0.10 * (station - 1), -0.10}; }
+double station_delay_s(int station) { return 0.5 * (station - 1); }
+
+Pose still(int station, Nanos) {
+  Pose p;
+  p.rotation = polhemus_attitude_to_quat(30.0, 10.0, -5.0);
+  p.translation = station_base(station);
+  return p;
+}
+
+Pose sweep(int station, Nanos t) {
+  const double s = nanos_to_seconds(t) - station_delay_s(station);
+  Pose p;
+  p.rotation = polhemus_attitude_to_quat(60.0 * std::sin(kTwoPi * 0.2 * s), 15.0 * std::sin(kTwoPi * 0.13 * s),
+                                         10.0 * std::sin(kTwoPi * 0.07 * s));
+  p.translation = station_base(station) + 0.05 * glm::dvec3(std::cos(kTwoPi * 0.1 * s), std::sin(kTwoPi * 0.1 * s),
+                                                            0.4 * std::sin(kTwoPi * 0.05 * s));
+  return p;
+}
+
+Pose spin(int station, Nanos t) {
+  const double s = nanos_to_seconds(t) - station_delay_s(station);
+  const double azimuth = std::remainder(36.0 * s, 360.0);
+  Pose p;
+  p.rotation = polhemus_attitude_to_quat(azimuth, 20.0, 0.0);
+  p.translation = station_base(station);
+  return p;
+}
+
+std::vector<std::string_view> split(std::string_view line) {
+  std::vector<std::string_view> fields;
+  std::size_t start = 0;
+  for (;;) {
+    const std::size_t comma = line.find(',', start);
+    fields.push_back(line.substr(start, comma == std::string_view::npos ? std::string_view::npos : comma - start));
+    if (comma == std::string_view::npos) return fields;
+    start = comma + 1;
+  }
+}
+
+template <class T>
+bool parse_number(std::string_view s, T& v) {
+  const auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
+  return ec == std::errc() && end == s.data() + s.size();
+}
+
+}  // namespace
+
+const std::vector<std::string>& builtin_trajectory_names() {
+  static const std::vector<std::string> names{"still", "sweep", "spin"};
+  return names;
+}
+
+Trajectory builtin_trajectory(const std::string& name) {
+  if (name == "still") return still;
+  if (name == "sweep") return sweep;
+  if (name == "spin") return spin;
+  throw InputError("trajectory \"" + name + "\" is not built in; use still, sweep, spin or a CSV file");
+}
+
+Trajectory load_trajectory_csv(const std::filesystem::path& path) {
+  std::ifstream in(path);
+  if (!in) throw InputError(path.string() + ": cannot read the trajectory; check the path");
+  const std::string where = path.string();
+  std::string line;
+  std::size_t line_number = 1;
+  if (!std::getline(in, line) || line.rfind("time_ns,station,x,y,z,qw,qx,qy,qz", 0) != 0)
+    throw InputError(where + ":1: the header must be time_ns,station,x,y,z,qw,qx,qy,qz (poses.csv)");
+  auto stream = std::make_shared<PoseStream>();
+  std::map<int, Nanos> last_time;
+  while (std::getline(in, line)) {
+    ++line_number;
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    if (line.empty()) continue;
+    const auto f = split(line);
+    auto fail = [&](const std::string& what) {
+      throw InputError(where + ":" + std::to_string(line_number) + ": " + what);
+    };
+    if (f.size() != 9) fail("expected 9 fields, found " + std::to_string(f.size()));
+    PoseSample s;
+    double v[7];
+    if (!parse_number(f[0], s.time) || !parse_number(f[1], s.station)) fail("time_ns and station must be integers");
+    for (int i = 0; i < 7; ++i)
+      if (!parse_number(f[2 + i], v[i]) || !std::isfinite(v[i])) fail("field " + std::to_string(3 + i) + " is not a number");
+    if (s.station < 1 || s.station > 9) fail("station " + std::to_string(s.station) + " is outside 1..9");
+    const glm::dquat q(v[3], v[4], v[5], v[6]);
+    const double norm = glm::length(q);
+    if (std::abs(norm - 1.0) > 0.01) fail("the quaternion is not unit length");
+    if (auto it = last_time.find(s.station); it != last_time.end() && s.time < it->second)
+      fail("time goes backwards for station " + std::to_string(s.station));
+    last_time[s.station] = s.time;
+    s.T_transmitter_sensor.translation = {v[0], v[1], v[2]};
+    s.T_transmitter_sensor.rotation = q / norm;
+    stream->add(s);
+  }
+  if (stream->size() == 0) throw InputError(where + ": no poses; the trajectory needs at least one row");
+  const int fallback = stream->stations().front();
+  return [stream, fallback](int station, Nanos t) {
+    const auto& samples = stream->samples(station).empty() ? stream->samples(fallback) : stream->samples(station);
+    const Nanos first = samples.front().time, last = samples.back().time;
+    if (last == first) return samples.front().T_transmitter_sensor;
+    const Nanos period = last - first;
+    const Nanos into = ((t % period) + period) % period;
+    const int st = samples.front().station;
+    // max_gap = the whole span: the CSV's rows define the motion, however sparse.
+    return stream->at(first + into, st, period).value_or(samples.front().T_transmitter_sensor);
+  };
+}
+
+}  // namespace lumar::tracking
