@@ -12,7 +12,7 @@ namespace lumar::app {
 
 namespace {
 struct OverlayOptions {
-  std::string recording, scene, out, frames_dir, poses = "tracker";
+  std::string recording, scene, out, frames_dir, contact_sheet, poses = "tracker";
   bool window = false;
   int max_frames = 0;
 };
@@ -26,13 +26,16 @@ void register_overlay(CLI::App& app) {
   cmd->add_option("--scene", o->scene, "Scene manifest; default: the one the recording's session names");
   cmd->add_option("--out", o->out, "Output video (.mp4, .mkv or .avi)");
   cmd->add_option("--frames-dir", o->frames_dir, "Also write every output frame as PNG into this new folder");
+  cmd->add_option("--contact-sheet", o->contact_sheet, "Also write 8 frames spread over the run, tiled, as one PNG");
   cmd->add_option("--poses", o->poses, "Camera poses from the tracker stream or from the recording's ground truth")
       ->check(CLI::IsMember({"tracker", "truth"}))->capture_default_str();
   cmd->add_flag("--window", o->window, "Show the result in a window (needs a display)");
   cmd->add_option("--max-frames", o->max_frames, "Stop after this many frames (0 = all)")->capture_default_str();
   add_action(cmd, [o] {
-    if (o->out.empty() && o->frames_dir.empty() && !o->window)
-      throw InputError("overlay: nothing to do; give --out, --frames-dir or --window");
+    if (o->out.empty() && o->frames_dir.empty() && o->contact_sheet.empty() && !o->window)
+      throw InputError("overlay: nothing to do; give --out, --frames-dir, --contact-sheet or --window");
+    if (!o->contact_sheet.empty() && std::filesystem::path(o->contact_sheet).extension() != ".png")
+      throw InputError(o->contact_sheet + ": the contact sheet must be a .png file");
     ReplayOverlay overlay(o->recording, o->scene, o->poses == "truth" ? PoseSource::Truth : PoseSource::Tracker,
                           o->window);
     const auto& camera = overlay.replay().session().camera;
@@ -41,7 +44,15 @@ void register_overlay(CLI::App& app) {
     std::optional<FramesOutput> frames;
     if (!o->out.empty()) video.emplace(o->out, fps, cv::Size(camera.width, camera.height));
     if (!o->frames_dir.empty()) frames.emplace(o->frames_dir);
+    // Eight frames spread evenly over the run, for the contact sheet.
+    std::int64_t total = std::int64_t(overlay.replay().reader().frames().size());
+    if (o->max_frames > 0) total = std::min<std::int64_t>(total, o->max_frames);
+    std::vector<std::pair<std::int64_t, cv::Mat>> sheet;
+    std::int64_t seen = 0;
     overlay.run(o->max_frames, [&](const OverlayFrame& f) {
+      if (!o->contact_sheet.empty() && int(sheet.size()) < 8 && seen * 7 >= std::int64_t(sheet.size()) * (total - 1))
+        sheet.emplace_back(f.index, f.composite.clone());
+      ++seen;
       if (video) video->write(f.composite);
       if (frames) frames->write(f.index, f.composite);
       if (auto* w = overlay.window()) {
@@ -53,6 +64,7 @@ void register_overlay(CLI::App& app) {
     });
     if (video) video->commit();
     if (frames) frames->commit();
+    if (!o->contact_sheet.empty()) write_contact_sheet(o->contact_sheet, sheet);
     const auto& stats = overlay.replay().tracker_stats();
     spdlog::info("overlay: {} frames{}{}; tracker: {} records, {} rejected, {} bytes skipped",
                  overlay.times().frames, o->out.empty() ? "" : " -> " + o->out,

@@ -172,7 +172,7 @@ Outcome regress_one(const fs::path& dir, bool update) {
            render_samples > 0 && tracked_errors.size() == frames.size();
   o.line = fmt::format(
       "{} {}: {} frames; golden PSNR min {} (>= {:.0f} dB); tracked-pose projection error mean {:.2f} px, worst "
-      "frame {:.2f} px (mean <= {:.1f}); render vs cv::projectPoints {:.4f} px over {} pixels (<= {:.1f}){}",
+      "frame {:.2f} px (mean <= {:.1f}); render vs cv::projectPoints {:.1e} px over {} pixels (<= {:.1f}){}",
       o.pass ? "PASS" : "FAIL", dir.string(), frames.size(), update ? std::string("(updated)") : fmt::format("{:.1f} dB", psnr_min),
       psnr_limit, tracked_mean, tracked_max, tracked_limit, render_error, render_samples, render_limit,
       tracked_errors.size() == frames.size() ? "" : fmt::format("; {} frames lacked a pose", frames.size() - tracked_errors.size()));

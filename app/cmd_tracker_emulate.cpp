@@ -41,6 +41,14 @@ struct EmulateOptions {
   std::string sent_log;
 };
 
+tracking::Device model_option(const std::string& name) {
+  try {
+    return tracking::parse_device(name);
+  } catch (const InputError& e) {
+    throw InputError(std::string("--model: ") + e.what());
+  }
+}
+
 std::vector<int> parse_stations(const std::string& text) {
   try {
     return tracking::parse_output_list(text);
@@ -61,7 +69,7 @@ std::string decoded_row(const tracking::SentRecord& r) {
 
 void run_emulate(const EmulateOptions& o) {
   tracking::EmulatorSettings s;
-  s.device = tracking::parse_device(o.model);
+  s.device = model_option(o.model);
   s.baud = o.baud;
   s.rate_hz = o.rate_hz;
   s.stations = parse_stations(o.stations);

@@ -5,6 +5,7 @@
 
 #include <chrono>
 #include <cstdio>
+#include <filesystem>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <thread>
@@ -47,11 +48,27 @@ std::string port_from_device(const std::string& device) {
 void run_record(const RecordOptions& o) {
   tracking::DriverSettings d;
   tracking::OutputFormat output;
-  output.output_list = tracking::parse_output_list(o.list);
+  tracking::Device device;
+  // Name the option in the message: the parsers only know the value.
+  try {
+    output.output_list = tracking::parse_output_list(o.list);
+    tracking::validate_output_format(output);
+  } catch (const InputError& e) {
+    throw InputError(std::string("--list: ") + e.what());
+  }
+  try {
+    device = tracking::parse_device(o.model);
+  } catch (const InputError& e) {
+    throw InputError(std::string("--model: ") + e.what());
+  }
   if (o.units != "in" && o.units != "cm") throw InputError("--units '" + o.units + "' is unknown; use in or cm");
   output.centimetres = o.units == "cm";
-  d.format = tracking::TrackerFormat::of(tracking::parse_device(o.model), o.binary, output);
-  d.stations = tracking::parse_output_list(o.stations);
+  d.format = tracking::TrackerFormat::of(device, o.binary, output);
+  try {
+    d.stations = tracking::parse_output_list(o.stations);
+  } catch (const InputError&) {
+    throw InputError("--stations '" + o.stations + "' is not a comma-separated list of station numbers, e.g. 1,2");
+  }
   d.continuous = o.poll_hz <= 0;
   if (!d.continuous) d.poll_rate_hz = o.poll_hz;
   for (double v : {o.latency_ms, o.reinit_wait_s, o.duration_s})
@@ -62,6 +79,9 @@ void run_record(const RecordOptions& o) {
   d.reinit_wait = seconds_to_nanos(o.reinit_wait_s);
   tracking::validate_driver_settings(d);
   tracking::SerialSettings serial{port_from_device(o.device), o.baud, o.rts_cts};
+  // Missing at the start is a typo or an unplugged device; later the driver waits for it.
+  if (std::error_code ec; !std::filesystem::exists(serial.path, ec))
+    throw InputError(serial.path + ": no such serial port; plug the tracker in or pick a port from `lumar devices`");
   const auto& bauds = tracking::supported_bauds();
   if (std::find(bauds.begin(), bauds.end(), serial.baud) == bauds.end())
     throw InputError("--baud " + std::to_string(serial.baud) + " is not supported; use 9600, 19200, 38400, 57600 or 115200");

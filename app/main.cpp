@@ -2,12 +2,16 @@
 // registers itself through register_*(); errors become one line and an exit status.
 #include <CLI/CLI.hpp>
 #include <cstdio>
+#include <cstdlib>
 #include <spdlog/spdlog.h>
 
 #include "commands.h"
 #include "lumar/core/error.h"
 
 int main(int argc, char** argv) {
+  // FFmpeg's own log lines (e.g. "overread 8" on a damaged segment) would break the
+  // promise of one clear error line; Lumar detects and reports those faults itself.
+  setenv("OPENCV_FFMPEG_LOGLEVEL", "-8", 0);
   CLI::App app{"lumar: composite virtual diffuse objects, lit by the real room, into camera video"};
   app.set_version_flag("--version", LUMAR_VERSION);
   app.require_subcommand(1);

@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include "lumar/core/error.h"
 
@@ -72,6 +73,27 @@ void FramesOutput::commit() {
   fs::rename(partial_, dir_, ec);
   if (ec) throw RuntimeError(dir_.string() + ": cannot move the frames into place (" + ec.message() + ")");
   committed_ = true;
+}
+
+void write_contact_sheet(const fs::path& png, const std::vector<std::pair<std::int64_t, cv::Mat>>& frames,
+                         int columns, int tile_width) {
+  if (frames.empty()) return;
+  const cv::Size first = frames.front().second.size();
+  const cv::Size tile(tile_width, tile_width * first.height / first.width);
+  const int rows = (int(frames.size()) + columns - 1) / columns;
+  cv::Mat sheet(rows * tile.height, std::min<int>(columns, frames.size()) * tile.width, CV_8UC3, cv::Scalar::all(0));
+  for (std::size_t i = 0; i < frames.size(); ++i) {
+    cv::Mat cell = sheet(cv::Rect(int(i % columns) * tile.width, int(i / columns) * tile.height, tile.width, tile.height));
+    cv::resize(frames[i].second, cell, tile, 0, 0, cv::INTER_AREA);
+    const std::string label = fmt::format("frame {}", frames[i].first);
+    cv::putText(cell, label, {7, 19}, cv::FONT_HERSHEY_SIMPLEX, 0.5, cv::Scalar::all(0), 2, cv::LINE_AA);
+    cv::putText(cell, label, {7, 19}, cv::FONT_HERSHEY_SIMPLEX, 0.5, cv::Scalar::all(255), 1, cv::LINE_AA);
+  }
+  const fs::path partial = png.parent_path() / ("." + png.filename().string() + ".partial.png");
+  if (!cv::imwrite(partial.string(), sheet)) throw RuntimeError(png.string() + ": cannot write PNG");
+  std::error_code ec;
+  fs::rename(partial, png, ec);
+  if (ec) throw RuntimeError(png.string() + ": cannot move the contact sheet into place (" + ec.message() + ")");
 }
 
 }  // namespace lumar::app

@@ -4,6 +4,8 @@
 #include <filesystem>
 #include <opencv2/core.hpp>
 #include <opencv2/videoio.hpp>
+#include <utility>
+#include <vector>
 
 namespace lumar::app {
 
@@ -33,5 +35,10 @@ class FramesOutput {
   std::filesystem::path dir_, partial_;
   bool committed_ = false;
 };
+
+// Tiles frames (each scaled to `tile_width`, aspect kept) into rows of `columns`, with
+// the frame index in a corner, and writes the PNG atomically.
+void write_contact_sheet(const std::filesystem::path& png, const std::vector<std::pair<std::int64_t, cv::Mat>>& frames,
+                         int columns = 4, int tile_width = 320);
 
 }  // namespace lumar::app

@@ -21,9 +21,13 @@ void BenchReport::compute_ratios() {
 
 void BenchReport::write_json(const std::filesystem::path& file) const {
   nlohmann::json j = {{"name", name}, {"title", title}, {"baseline", baseline}, {"error_label", error_label}};
+  if (!x_label.empty()) j["x_label"] = x_label;
+  if (!highlight.empty()) j["highlight"] = highlight;
+  if (!note.empty()) j["note"] = note;
   for (const auto& e : entries) {
     nlohmann::json row = {{"name", e.name}, {"time_ms", e.time_ms}, {"ratio_to_baseline", e.ratio}};
     if (!std::isnan(e.error)) row["error"] = e.error;
+    if (!std::isnan(e.x)) row["x"] = e.x;
     j["entries"].push_back(row);
   }
   const auto tmp = file.string() + ".tmp";
@@ -45,10 +49,58 @@ std::string short_number(double v) { return fmt::format("{:.3g}", v); }
 
 void BenchReport::write_chart(const std::filesystem::path& file) const {
   const bool tradeoff = std::any_of(entries.begin(), entries.end(), [](const auto& e) { return !std::isnan(e.error); });
+  const bool xy = std::any_of(entries.begin(), entries.end(), [](const auto& e) { return !std::isnan(e.x); });
   const int W = 900, H = tradeoff ? 560 : 120 + 34 * int(entries.size());
   cv::Mat img(H, W, CV_8UC3, cv::Scalar(255, 255, 255));
   text(img, title, {20, 30}, 0.6);
-  if (!tradeoff) {
+  if (xy) {
+    // Error against x, both on log axes (x at or below 0 is drawn at the left edge);
+    // the choice, the baseline and the Pareto front are labelled.
+    const int left = 90, right = W - 40, top = 60, bottom = H - 80;
+    double x0 = 1e300, x1 = 0, e0 = 1e300, e1 = 0;
+    for (const auto& e : entries) {
+      if (std::isnan(e.x) || std::isnan(e.error)) continue;
+      if (e.x > 0) x0 = std::min(x0, e.x), x1 = std::max(x1, e.x);
+      e0 = std::min(e0, std::max(e.error, 1e-6)), e1 = std::max(e1, std::max(e.error, 1e-6));
+    }
+    if (x1 == 0) x0 = x1 = 1;
+    const double lx0 = std::floor(std::log10(x0)) - 1, lx1 = std::ceil(std::log10(x1)) + (x1 == x0 ? 1 : 0);
+    const double le0 = std::floor(std::log10(e0)), le1 = std::ceil(std::log10(e1)) + (e1 == e0 ? 1 : 0);
+    auto px = [&](double x) {
+      return left + int((right - left) * (std::log10(std::max(x, std::pow(10, lx0))) - lx0) / (lx1 - lx0));
+    };
+    auto py = [&](double e) { return bottom - int((bottom - top) * (std::log10(std::max(e, 1e-6)) - le0) / (le1 - le0)); };
+    for (double d = lx0; d <= lx1; d += 1)
+      for (int m : {1, 2, 5}) {
+        const double v = m * std::pow(10, d);
+        if (v > std::pow(10, lx1)) break;
+        cv::line(img, {px(v), top}, {px(v), bottom}, kGrid);
+        text(img, short_number(v), {px(v) - 8, bottom + 20}, 0.4);
+      }
+    for (double d = le0; d <= le1; d += 1)
+      for (int m : {1, 2, 5}) {
+        const double v = m * std::pow(10, d);
+        if (v > std::pow(10, le1)) break;
+        cv::line(img, {left, py(v)}, {right, py(v)}, kGrid);
+        text(img, short_number(v), {10, py(v) + 5}, 0.4);
+      }
+    cv::rectangle(img, {left, top}, {right, bottom}, kInk);
+    text(img, x_label + " (log)", {(left + right) / 2 - 120, H - 45});
+    text(img, error_label + " (log)", {left, top - 10}, 0.42);
+    if (!note.empty()) text(img, note, {20, H - 15}, 0.4);
+    for (const auto& e : entries) {
+      if (std::isnan(e.x) || std::isnan(e.error)) continue;
+      const cv::Point p(px(e.x), py(e.error));
+      const bool chosen = e.name == highlight;
+      const bool front = std::none_of(entries.begin(), entries.end(), [&](const auto& o) {
+        return &o != &e && o.x <= e.x && o.error <= e.error && (o.x < e.x || o.error < e.error);
+      });
+      cv::circle(img, p, chosen ? 7 : 4, e.name == baseline ? kBar : chosen ? cv::Scalar(40, 160, 40) : kDot,
+                 cv::FILLED, cv::LINE_AA);
+      if (chosen || front || e.name == baseline)
+        text(img, e.name, p + cv::Point(9, 4), chosen ? 0.45 : 0.36, chosen ? cv::Scalar(40, 130, 40) : kInk);
+    }
+  } else if (!tradeoff) {
     // Horizontal bars: one per entry, time in ms, ratio to the baseline after it.
     const int left = 260, right = W - 170, top = 60;
     double tmax = 0;
@@ -102,11 +154,12 @@ void BenchReport::save(const std::filesystem::path& dir) const {
   std::filesystem::create_directories(dir);
   write_json(dir / (name + ".json"));
   write_chart(dir / (name + ".png"));
-  std::printf("\n%s\n%-34s %12s %10s %14s\n", title.c_str(), "entry", "ms/op", "x baseline",
-              error_label.empty() ? "" : "error");
+  std::printf("\n%s\n%-34s %12s %10s %14s %10s\n", title.c_str(), "entry", "ms/op", "x baseline",
+              error_label.empty() ? "" : "error", x_label.empty() ? "" : "x");
   for (const auto& e : entries)
-    std::printf("%-34s %12.4g %10.3f %14s\n", e.name.c_str(), e.time_ms, e.ratio,
-                std::isnan(e.error) ? "" : fmt::format("{:.4g}", e.error).c_str());
+    std::printf("%-34s %12.4g %10.3f %14s %10s\n", e.name.c_str(), e.time_ms, e.ratio,
+                std::isnan(e.error) ? "" : fmt::format("{:.4g}", e.error).c_str(),
+                std::isnan(e.x) ? "" : fmt::format("{:.4g}", e.x).c_str());
   std::printf("-> %s/%s.{json,png}\n", dir.c_str(), name.c_str());
 }
 

@@ -14,6 +14,8 @@ struct BenchEntry {
   double time_ms = 0;                                       // per operation
   double error = std::numeric_limits<double>::quiet_NaN();  // against the reference; NaN = not measured
   double ratio = 0;                                         // time_ms / baseline time_ms
+  // A second measured quantity for an x/y chart (e.g. lag in ms); NaN = not measured.
+  double x = std::numeric_limits<double>::quiet_NaN();
 };
 
 struct BenchReport {
@@ -21,12 +23,19 @@ struct BenchReport {
   std::string title;
   std::string baseline;      // entry whose time every ratio divides by
   std::string error_label;   // what `error` measures, e.g. "mean relative irradiance error (%)"
+  // x/y chart: when entries carry `x`, the chart is `error` against `x` (log axes; x <= 0
+  // sits at the left edge) labelled x_label; `highlight` names an entry drawn larger,
+  // e.g. a choice; the Pareto front (no entry both lower and left) is labelled.
+  std::string x_label;
+  std::string highlight;
+  std::string note;          // one line printed under the chart
   std::vector<BenchEntry> entries;
 
   void compute_ratios();
   void write_json(const std::filesystem::path& file) const;
   // Bars of time per entry (ratio printed beside), or, when entries carry errors, a
-  // scatter of error against time on log axes: the speed/accuracy chart.
+  // scatter of error against time on log axes: the speed/accuracy chart; or, when they
+  // carry x, error against x (see x_label).
   void write_chart(const std::filesystem::path& file) const;
   // Writes <dir>/<name>.json and <dir>/<name>.png and prints a table.
   void save(const std::filesystem::path& dir) const;

@@ -22,9 +22,11 @@ void RecordingSource::open_segment(int segment) {
   for (std::size_t i = next_; i < frames_.size() && frames_[i].segment == segment; ++i)
     ++segment_rows_;
   decoded_ = 0;
-  // OpenCV's own MJPEG reader decodes with libjpeg and converts colour exactly
-  // (mean error 0.49 levels at quality 95, against 0.83 through FFmpeg's swscale).
-  const int api = video_.codec == "mjpeg" ? cv::CAP_OPENCV_MJPEG : cv::CAP_FFMPEG;
+  // FFmpeg for both codecs. OpenCV's own MJPEG reader converts colour slightly more
+  // exactly (mean error 0.49 levels at quality 95, against 0.83), but OpenCV 4.6's MJPEG
+  // encoder cuts the last bytes of about one frame in 32 (opencv#24171) and libjpeg then
+  // prints "Corrupt JPEG data" on stderr for each; FFmpeg decodes them silently.
+  const int api = cv::CAP_FFMPEG;
   std::error_code ec;
   if (!std::filesystem::exists(segment_file_, ec) || !capture_.open(segment_file_.string(), api))
     fail_truncated();

@@ -41,7 +41,7 @@ case_truncated_video() {
   seg=$(ls "$TMP"/rec/video/segment-* | head -1)
   truncate -s $(( $(stat -c %s "$seg") / 2 )) "$seg"
   expect_bad_input "$(basename "$seg")" "$TMP/out.mp4" -- \
-    "$LUMAR" overlay --recording "$TMP/rec" --out "$TMP/out.mp4"
+    "$LUMAR" overlay --recording "$TMP/rec" --scene "$SRC/data/scenes/room/scene.json" --out "$TMP/out.mp4"
 }
 
 case_malformed_session_json() {

@@ -6,12 +6,14 @@ frames_in_recording() { grep -c '^[0-9]' "$REC/frames.csv"; }
 
 case_headless_writes_video_and_frames() {
   [ -z "${DISPLAY:-}" ] || fail "DISPLAY should be unset"
-  "$LUMAR" overlay --recording "$REC" --out "$TMP/out.mp4" --frames-dir "$TMP/frames" >"$TMP/log" 2>&1 ||
+  "$LUMAR" overlay --recording "$REC" --out "$TMP/out.mp4" --frames-dir "$TMP/frames" \
+    --contact-sheet "$TMP/sheet.png" >"$TMP/log" 2>&1 ||
     { cat "$TMP/log"; fail "overlay failed"; }
   [ -s "$TMP/out.mp4" ] || fail "no video written"
   n=$(ls "$TMP/frames" | wc -l)
   [ "$n" -eq "$(frames_in_recording)" ] || fail "$n PNG frames, expected $(frames_in_recording)"
   grep -q "virtual objects" "$TMP/log" || fail "no per-stage timing summary"
+  [ "$(head -c 8 "$TMP/sheet.png" | od -An -tx1 | tr -d ' ')" = "89504e470d0a1a0a" ] || fail "no PNG contact sheet"
   cat "$TMP/log"
 }
 
@@ -32,6 +34,34 @@ case_window_without_display_fails_cleanly() {
 case_regress_sample() {
   "$LUMAR" regress "$REC" | tee "$TMP/log" || fail "regression failed"
   grep -q "^PASS" "$TMP/log" || fail "no PASS line"
+}
+
+# A copy of the sample recording at the same depth, so its relative scene path still resolves.
+copy_recording() {
+  ln -s "$SRC/data" "$TMP/data"
+  mkdir -p "$TMP/recordings"
+  cp -r "$REC" "$TMP/recordings/orbit"
+}
+
+case_regress_detects_a_wrong_golden_frame() {
+  copy_recording
+  cp "$TMP/recordings/orbit/expected/frame-000047.png" "$TMP/recordings/orbit/expected/frame-000015.png"
+  "$LUMAR" regress "$TMP/recordings/orbit" >"$TMP/log" 2>&1
+  status=$?
+  cat "$TMP/log"
+  [ $status -eq 1 ] || fail "regress passed with a wrong golden frame (status $status)"
+  grep -q "^FAIL" "$TMP/log" || fail "no FAIL line"
+}
+
+case_regress_detects_a_shifted_tracker() {
+  copy_recording
+  # Claim a latency 150 ms off: the replayed poses lag the truth and the object drifts.
+  sed -i 's/"latency_ns": 20000000/"latency_ns": 170000000/' "$TMP/recordings/orbit/session.json"
+  grep -q '"latency_ns": 170000000' "$TMP/recordings/orbit/session.json" || fail "could not edit the latency"
+  "$LUMAR" regress "$TMP/recordings/orbit" >"$TMP/log" 2>&1
+  status=$?
+  cat "$TMP/log"
+  [ $status -eq 1 ] || fail "regress passed with a wrong latency (status $status)"
 }
 
 case_help_describes_every_option() {

@@ -94,7 +94,6 @@ struct TrackerDriver::Impl {
   // Reader thread only.
   std::unique_ptr<ByteTransport> transport;
   int level = 0;
-  std::uint64_t parsed_records = 0, parsed_rejected = 0, parsed_skipped = 0;  // of finished parsers
 
   Impl(const DriverSettings& s, TransportFactory open, ByteObserver observer)
       : settings(s), open_transport(std::move(open)), on_bytes(std::move(observer)), queue(s.queue_capacity) {}
@@ -224,6 +223,7 @@ struct TrackerDriver::Impl {
     Nanos last_valid = monotonic_now();
     Nanos next_poll = last_valid;
     bool receiving = false;
+    std::size_t counted_records = 0, counted_rejected = 0, counted_skipped = 0;
     for (;;) {
       Nanos now = monotonic_now();
       if (!settings.continuous && now >= next_poll) {
@@ -254,16 +254,17 @@ struct TrackerDriver::Impl {
         }
       }
       update([&](DriverStatus& s) {
-        s.records = parsed_records + parser.accepted_records();
-        s.rejected_records = parsed_rejected + parser.rejected_records();
-        s.skipped_bytes = parsed_skipped + parser.skipped_bytes();
+        // Add what this parser counted since the last update (it lives one connection).
+        s.records += parser.accepted_records() - counted_records;
+        s.rejected_records += parser.rejected_records() - counted_rejected;
+        s.skipped_bytes += parser.skipped_bytes() - counted_skipped;
         s.samples_dropped += dropped;
         if (valid > 0) s.last_record = last_valid;
       });
+      counted_records = parser.accepted_records();
+      counted_rejected = parser.rejected_records();
+      counted_skipped = parser.skipped_bytes();
       if (now - last_valid > settings.watchdog) {
-        parsed_records += parser.accepted_records();
-        parsed_rejected += parser.rejected_records();
-        parsed_skipped += parser.skipped_bytes();
         // Streaming for a while and then silence: start gently. Never receiving after
         // a good status: the next reset needs more force.
         level = receiving ? 0 : (level + 1) % 3;
