@@ -15,7 +15,7 @@
 #include "lumar/tracking/tracker_decode.h"
 // parse_tracker_chunks is private to capture/ (capture/src); the decoder needs exactly
 // that reader, so it is included from there rather than copied.
-#include "../capture/src/tracker_raw.h"
+#include "lumar/capture/tracker_raw.h"
 
 namespace lumar::app {
 

@@ -123,6 +123,7 @@ void run_emulate(const EmulateOptions& o) {
   while (!stop_requested() && (end == 0 || monotonic_now() < end)) {
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
     if (const std::string now = emulator.port_path(); now != port) describe(port = now);
+    if (const std::string why = emulator.failure(); !why.empty()) throw RuntimeError("emulator stopped: " + why);
   }
   emulator.stop();
   const auto c = emulator.counters();

@@ -79,9 +79,16 @@ void run_record(const RecordOptions& o) {
   d.reinit_wait = seconds_to_nanos(o.reinit_wait_s);
   tracking::validate_driver_settings(d);
   tracking::SerialSettings serial{port_from_device(o.device), o.baud, o.rts_cts};
-  // Missing at the start is a typo or an unplugged device; later the driver waits for it.
+  // Missing at the start is a typo or an unplugged device, and a file that is not a
+  // serial port is a wrong path: say so now. Later the driver waits for a vanished port.
   if (std::error_code ec; !std::filesystem::exists(serial.path, ec))
     throw InputError(serial.path + ": no such serial port; plug the tracker in or pick a port from `lumar devices`");
+  try {
+    tracking::SerialTransport probe(serial);
+  } catch (const tracking::DeviceVanished&) {
+  } catch (const RuntimeError& e) {
+    throw InputError(e.what());
+  }
   const auto& bauds = tracking::supported_bauds();
   if (std::find(bauds.begin(), bauds.end(), serial.baud) == bauds.end())
     throw InputError("--baud " + std::to_string(serial.baud) + " is not supported; use 9600, 19200, 38400, 57600 or 115200");

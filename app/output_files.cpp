@@ -16,7 +16,7 @@ VideoOutput::VideoOutput(fs::path path, double fps, cv::Size size) : path_(std::
   if (!path_.parent_path().empty() && !fs::is_directory(path_.parent_path()))
     throw InputError(path_.string() + ": folder " + path_.parent_path().string() + " does not exist");
   // The partial file keeps the extension so that FFmpeg picks the same container.
-  partial_ = path_.parent_path() / ("." + path_.stem().string() + ".partial" + path_.extension().string());
+  partial_ = path_.parent_path() / fmt::format(".{}.partial{}", path_.stem().string(), path_.extension().string());
   // H.264 where the FFmpeg build has an encoder for it, else MPEG-4 part 2.
   for (const char* fourcc : {"avc1", "mp4v"}) {
     writer_.open(partial_.string(), cv::CAP_FFMPEG, cv::VideoWriter::fourcc(fourcc[0], fourcc[1], fourcc[2], fourcc[3]),
@@ -49,7 +49,7 @@ void VideoOutput::commit() {
 
 FramesOutput::FramesOutput(fs::path dir) : dir_(std::move(dir)) {
   if (fs::exists(dir_)) throw InputError(dir_.string() + ": already exists; choose a new folder for the frames");
-  partial_ = dir_.parent_path() / ("." + dir_.filename().string() + ".partial");
+  partial_ = dir_.parent_path() / fmt::format(".{}.partial", dir_.filename().string());
   std::error_code ec;
   fs::remove_all(partial_, ec);
   if (!fs::create_directories(partial_, ec) || ec)
@@ -89,7 +89,7 @@ void write_contact_sheet(const fs::path& png, const std::vector<std::pair<std::i
     cv::putText(cell, label, {7, 19}, cv::FONT_HERSHEY_SIMPLEX, 0.5, cv::Scalar::all(0), 2, cv::LINE_AA);
     cv::putText(cell, label, {7, 19}, cv::FONT_HERSHEY_SIMPLEX, 0.5, cv::Scalar::all(255), 1, cv::LINE_AA);
   }
-  const fs::path partial = png.parent_path() / ("." + png.filename().string() + ".partial.png");
+  const fs::path partial = png.parent_path() / fmt::format(".{}.partial.png", png.filename().string());
   if (!cv::imwrite(partial.string(), sheet)) throw RuntimeError(png.string() + ": cannot write PNG");
   std::error_code ec;
   fs::rename(partial, png, ec);

@@ -71,36 +71,37 @@ void replay_frame(benchmark::State& state) {
     const auto pose = f.replay.tracked_camera_pose(frame.time);
     if (pose) benchmark::DoNotOptimize(f.compositor->composite(frame.image, *pose, exposure).data);
   }
-  state.counters["fps"] = benchmark::Counter(double(state.iterations()), benchmark::Counter::kIsRate);
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
-  benchmark::RegisterBenchmark("decode_frame", decode_frame)->Unit(benchmark::kMillisecond)->MinTime(1.0);
-  benchmark::RegisterBenchmark("composite_frame", composite_frame)->Unit(benchmark::kMillisecond)->MinTime(2.0);
-  benchmark::RegisterBenchmark("replay_frame", replay_frame)->Unit(benchmark::kMillisecond)->MinTime(2.0);
+  benchmark::RegisterBenchmark("decode_frame", decode_frame)->Unit(benchmark::kMillisecond)->MinTime(1.0)->UseRealTime();
+  benchmark::RegisterBenchmark("composite_frame", composite_frame)->Unit(benchmark::kMillisecond)->MinTime(2.0)->UseRealTime();
+  benchmark::RegisterBenchmark("replay_frame", replay_frame)->Unit(benchmark::kMillisecond)->MinTime(2.0)->UseRealTime();
   benchmark::Initialize(&argc, argv);
   bench::CollectingReporter reporter;
   benchmark::RunSpecifiedBenchmarks(&reporter);
 
-  const auto& r = reporter.results();
-  if (!r.count("decode_frame") || !r.count("composite_frame") || !r.count("replay_frame")) return 0;  // filtered run
-  const auto& c = r.at("composite_frame").counters;
+  const auto* decode = reporter.find("decode_frame");
+  const auto* composite = reporter.find("composite_frame");
+  const auto* replay = reporter.find("replay_frame");
+  if (!decode || !composite || !replay) return 0;  // a filtered run: no report
+  const auto& c = composite->counters;
   bench::BenchReport report;
   report.name = "overlay_stages";
   report.title = "Overlay at 640x480, sample recording, Mesa llvmpipe: time per stage";
   report.baseline = "decode one video frame";
-  report.entries = {{"decode one video frame", r.at("decode_frame").time_ms},
+  report.entries = {{"decode one video frame", decode->time_ms},
                     {"upload frame", c.at("upload_ms")},
                     {"background (undistort)", c.at("background_ms")},
                     {"proxy depth", c.at("depth_ms")},
                     {"virtual objects (SH9)", c.at("objects_ms")},
                     {"read back", c.at("readback_ms")},
-                    {"composite, all stages", r.at("composite_frame").time_ms},
-                    {"replay: decode+pose+composite", r.at("replay_frame").time_ms}};
+                    {"composite, all stages", composite->time_ms},
+                    {"replay: decode+pose+composite", replay->time_ms}};
   report.compute_ratios();
   report.save(bench::results_dir());
-  std::printf("replay throughput: %.1f frames/s\n", 1000.0 / r.at("replay_frame").time_ms);
+  std::printf("replay throughput: %.1f frames/s\n", 1000.0 / replay->time_ms);
   return 0;
 }

@@ -172,6 +172,12 @@ std::filesystem::path results_dir() {
 
 namespace lumar::bench {
 
+const CollectingReporter::Result* CollectingReporter::find(const std::string& name) const {
+  for (const auto& [key, result] : results_)
+    if (key == name || key.rfind(name + "/", 0) == 0) return &result;
+  return nullptr;
+}
+
 void CollectingReporter::ReportRuns(const std::vector<Run>& runs) {
   benchmark::ConsoleReporter::ReportRuns(runs);
   for (const Run& run : runs) {

@@ -61,6 +61,9 @@ class CollectingReporter : public benchmark::ConsoleReporter {
   };
   void ReportRuns(const std::vector<Run>& runs) override;
   const std::map<std::string, Result>& results() const { return results_; }
+  // The result of the benchmark registered as `name` (Google Benchmark appends
+  // "/min_time:..." and the like to the names it reports); nullptr if it did not run.
+  const Result* find(const std::string& name) const;
 
  private:
   std::map<std::string, Result> results_;

@@ -90,10 +90,11 @@ int main(int argc, char** argv) {
   report.error_label = "mean relative irradiance error vs brute force (%)";
   for (int f : factors) {
     const std::string key = "sh9_projection/" + std::to_string(maps[f].width);
-    if (!reporter.results().count(key)) continue;
+    const auto* result = reporter.find(key);
+    if (!result) continue;
     const std::string name = fmt::format("{}x{}", maps[f].width, maps[f].height);
     if (f == 1) report.baseline = name;
-    report.entries.push_back({name, reporter.results().at(key).time_ms,
+    report.entries.push_back({name, result->time_ms,
                               mean_relative_error_percent(project_radiance_sh9(maps[f]), ns, ref)});
   }
   report.compute_ratios();

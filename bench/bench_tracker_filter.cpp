@@ -174,9 +174,8 @@ int main(int argc, char** argv) {
   benchmark::Initialize(&argc, argv);
   bench::CollectingReporter reporter;
   benchmark::RunSpecifiedBenchmarks(&reporter);
-  const double filter_ms = reporter.results().count("one_euro_pose_filter/sample")
-                               ? reporter.results().at("one_euro_pose_filter/sample").time_ms
-                               : 0.0;
+  const auto* timing = reporter.find("one_euro_pose_filter/sample");
+  const double filter_ms = timing ? timing->time_ms : 0.0;
 
   bench::BenchReport report;
   report.name = "tracker_filter";

@@ -5,7 +5,7 @@
 #include "csv_text.h"
 #include "lumar/capture/recording_source.h"
 #include "lumar/core/error.h"
-#include "tracker_raw.h"
+#include "lumar/capture/tracker_raw.h"
 
 namespace lumar::capture {
 namespace fs = std::filesystem;

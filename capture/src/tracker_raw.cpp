@@ -1,4 +1,4 @@
-#include "tracker_raw.h"
+#include "lumar/capture/tracker_raw.h"
 
 #include <zlib.h>
 

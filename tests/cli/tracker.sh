@@ -115,6 +115,7 @@ case_bad_tracker_input() {
     --device serial:/dev/lumar-no-such-port --out "$TMP/rec"
   expect_bad_input "--list" "$TMP/rec" -- "$LUMAR" tracker record --device serial:/dev/null --out "$TMP/rec" --list 2,99
   expect_bad_input "nowhere.csv" "" -- "$LUMAR" tracker emulate --trajectory "$TMP/nowhere.csv"
+  expect_bad_input "/dev/null" "$TMP/rec" -- "$LUMAR" tracker record --device serial:/dev/null --out "$TMP/rec"
 }
 
 run_case

@@ -91,6 +91,31 @@ case_tracker_raw_chunks() {
   echo "ok: $(cat "$TMP/stderr")"
 }
 
+case_sample_recording_matches_its_poses() {
+  # The sample recording's tracker.raw, decoded, gives the poses its writer decoded
+  # live (poses.csv: time_ns,station,x,y,z,qw,qx,qy,qz at full precision).
+  local rec=$SRC/recordings/orbit
+  [ -f "$rec/tracker.raw" ] || fail "no sample recording at $rec"
+  # The tracker settings from session.json (one line, no spaces, for grep).
+  local session list units=in
+  session=$(tr -d ' \n' <"$rec/session.json")
+  grep -q '"encoding":"ascii"' <<<"$session" || fail "sample recording is not ASCII"
+  list=$(grep -o '"output_list":\[[0-9,]*\]' <<<"$session" | grep -o '[0-9][0-9,]*')
+  [ -n "$list" ] || fail "no output list in session.json"
+  grep -q '"centimetres":true' <<<"$session" && units=cm
+  "$LUMAR" tracker decode "$rec/tracker.raw" --list "$list" --units $units >"$TMP/stdout" 2>"$TMP/stderr" \
+    || fail "exit status $?"
+  [ "$(head -1 "$TMP/stdout")" = "$HEADER" ] || fail "header"
+  tail -n +2 "$rec/poses.csv" | cut -d, -f2- >"$TMP/poses"
+  tail -n +2 "$TMP/stdout" >"$TMP/decoded"
+  [ "$(wc -l <"$TMP/poses")" -gt 100 ] || fail "too few poses in the sample"
+  [ "$(wc -l <"$TMP/poses")" -eq "$(wc -l <"$TMP/decoded")" ] || fail "row counts differ"
+  paste -d, "$TMP/poses" "$TMP/decoded" | awk -F, '
+    { for (i = 1; i <= 8; ++i) { d = $i - $(i + 8); if (d < 0) d = -d; if (d > 5.1e-7) { print "row " NR " column " i ": " $i " vs " $(i + 8); bad = 1 } } }
+    END { exit bad }' || fail "decoded poses differ from poses.csv"
+  echo "ok: $(wc -l <"$TMP/decoded") poses match; $(cat "$TMP/stderr")"
+}
+
 case_missing_file() {
   expect_bad_input "$TMP/nope.raw" "$TMP/out.csv" -- \
     "$LUMAR" tracker decode "$TMP/nope.raw" --out "$TMP/out.csv"

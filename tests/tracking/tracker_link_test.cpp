@@ -22,6 +22,12 @@ struct LinkCase {
   std::vector<int> stations;
 };
 
+void PrintTo(const LinkCase& c, std::ostream* os) {
+  *os << device_name(c.device) << (c.binary ? " binary" : " ASCII") << (c.centimetres ? " cm" : " in") << " list";
+  for (int i : c.list) *os << ' ' << i;
+  *os << ", " << c.stations.size() << " station(s)";
+}
+
 std::string case_name(const testing::TestParamInfo<LinkCase>& info) {
   const LinkCase& c = info.param;
   std::string name = device_name(c.device) + (c.binary ? "_binary_" : "_ascii_") + (c.centimetres ? "cm_" : "in_");

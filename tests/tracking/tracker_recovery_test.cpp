@@ -46,18 +46,22 @@ TEST(TrackerRecovery, ReconnectsAfterThePortVanishes) {
 
   link.emulator().disconnect_for(400'000'000);
   ASSERT_TRUE(link.run_until([&] { return !link.emulator().connected(); }, 1'000'000'000));
-  Nanos back = 0;
+  Nanos back = 0, first_new = 0;
+  std::size_t at_back = 0;
   ASSERT_TRUE(link.run_until(
       [&] {
-        if (!back && link.emulator().connected()) back = monotonic_now();
+        if (!back && link.emulator().connected()) {
+          back = monotonic_now();
+          at_back = link.samples().size();
+        }
+        if (back && !first_new && link.samples().size() > at_back) first_new = monotonic_now();
         return back && link.samples().size() > before + 10;
       },
       5'000'000'000))
       << state_name(link.status().state) << ": " << link.status().message;
-  const Nanos reconnect = link.last_sample_seen() - back;  // approximately: first new sample seen
+  const Nanos reconnect = first_new - back;  // the pty is back -> the first new sample is taken
   link.finish();
 
-  // Find when the first post-outage sample came in: the one after the gap.
   const Nanos bound = ds.watchdog + reset_time(ds, es.rate_hz);
   std::printf("  port back -> records flowing again: %.1f ms (bound: watchdog + reset = %.1f ms); vanished %llu, "
               "connects %llu; max take_samples %.3f ms, status %.3f ms; stop %.1f ms\n",
@@ -92,9 +96,16 @@ TEST(TrackerRecovery, AHungDeviceIsResetWithRisingForce) {
   const std::size_t before = link.samples().size();
   const Nanos hung = monotonic_now();
   link.emulator().silence_for(60'000'000'000);  // only Ctrl-Y brings it back
-  ASSERT_TRUE(link.run_until([&] { return link.samples().size() > before + 20; }, 8'000'000'000))
+  Nanos first_new = 0;  // when the first sample measured after the hang was taken
+  ASSERT_TRUE(link.run_until(
+      [&] {
+        if (!first_new && !link.samples().empty() && link.samples().back().time > hung) first_new = monotonic_now();
+        return link.samples().size() > before + 20;
+      },
+      8'000'000'000))
       << state_name(link.status().state) << ": " << link.status().message;
-  const Nanos recovered = link.last_sample_seen() - hung;
+  ASSERT_GT(first_new, 0);
+  const Nanos recovered = first_new - hung;
   link.shut_down();
 
   const auto counters = link.emulator().counters();
@@ -222,6 +233,14 @@ TEST(SerialTransportDeadlines, AVanishingPortEndsAReadAtOnce) {
   EXPECT_THROW(port.read(10'000'000), DeviceVanished);
   EXPECT_THROW(SerialTransport({"/dev/lumar-no-such-port", 115200, false}), DeviceVanished);
   EXPECT_THROW(SerialTransport({emulator.port_path(), 12345, false}), InputError);
+  try {
+    SerialTransport not_a_tty({"/dev/null", 115200, false});
+    ADD_FAILURE() << "/dev/null opened as a serial port";
+  } catch (const DeviceVanished&) {
+    ADD_FAILURE() << "a wrong path is not a vanished device";
+  } catch (const RuntimeError& e) {
+    EXPECT_NE(std::string(e.what()).find("not a serial port"), std::string::npos) << e.what();
+  }
 }
 
 // LibSerial leaves TIOCEXCL set (a non-root process could not reopen the port); the

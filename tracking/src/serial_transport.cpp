@@ -69,10 +69,14 @@ SerialTransport::SerialTransport(SerialSettings settings) : settings_(std::move(
   } catch (const std::exception& e) {
     const int err = errno;
     std::string why = e.what();
+    // Open() can fail after opening the descriptor (e.g. no termios on a non-tty).
+    port->fd = port->serial.IsOpen() ? port->serial.GetFileDescriptor() : -1;
+    if (port->fd >= 0) close_port(port);
     if (err == EACCES)
       throw RuntimeError(path + ": permission denied; add your user to the 'dialout' group and log in again");
     if (err == EBUSY)
       throw RuntimeError(path + ": in use by another program (exclusive); close it and retry");
+    if (err == ENOTTY) throw RuntimeError(path + ": not a serial port; pick one from `lumar devices`");
     if (err == ENOENT || err == ENXIO || err == ENODEV || err == EIO)
       throw DeviceVanished(path + ": cannot open (" + why + "); the device is not there");
     throw RuntimeError(path + ": cannot open the serial port (" + why + ")");
@@ -90,7 +94,9 @@ SerialTransport::SerialTransport(SerialSettings settings) : settings_(std::move(
     port->serial.SetFlowControl(settings_.rts_cts ? LibSerial::FlowControl::FLOW_CONTROL_HARDWARE
                                                   : LibSerial::FlowControl::FLOW_CONTROL_NONE);
   } catch (const std::exception& e) {
-    throw RuntimeError(path + ": cannot configure " + std::to_string(settings_.baud) + " baud 8N1 (" + e.what() +
+    const std::string why = e.what();
+    close_port(port);
+    throw RuntimeError(path + ": cannot configure " + std::to_string(settings_.baud) + " baud 8N1 (" + why +
                        "); is this a serial port?");
   }
   port_ = std::move(port);
@@ -100,7 +106,9 @@ SerialTransport::~SerialTransport() { close(); }
 
 bool SerialTransport::is_open() const { return port_ != nullptr; }
 
-void SerialTransport::close() {
+void SerialTransport::close() { close_port(port_); }
+
+void SerialTransport::close_port(std::unique_ptr<Port>& port_) {
   if (!port_) return;
   try {
     port_->serial.Close();

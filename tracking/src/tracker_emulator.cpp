@@ -105,6 +105,7 @@ struct TrackerEmulator::Impl {
   std::string port_path;
   Nanos requested_disconnect = -1, requested_silence = -1;
   bool stopping = false;
+  std::string failure;  // why the device thread ended early ("" = it did not)
   int wake_fd = -1;
   std::thread thread;
 
@@ -203,7 +204,12 @@ struct TrackerEmulator::Impl {
       if (r.garbage_bytes > 0) ++c.records_damaged;
       if (r.cut_short) ++c.records_cut_short;
     });
-    if (on_record) on_record(r);
+    if (!on_record) return;
+    try {
+      on_record(r);
+    } catch (...) {
+      // The observer's problem must not stop the device.
+    }
   }
 
   int next_active_station() {
@@ -492,6 +498,18 @@ struct TrackerEmulator::Impl {
   }
 
   void run() {
+    try {
+      loop();
+    } catch (const std::exception& e) {
+      std::lock_guard lock(mutex);
+      failure = e.what();
+    }
+    if (pty) pty->close();
+    std::lock_guard lock(mutex);
+    port_path.clear();
+  }
+
+  void loop() {
     for (;;) {
       {
         std::lock_guard lock(mutex);
@@ -592,6 +610,11 @@ std::string TrackerEmulator::port_path() const {
 }
 
 bool TrackerEmulator::connected() const { return !port_path().empty(); }
+
+std::string TrackerEmulator::failure() const {
+  std::lock_guard lock(impl_->mutex);
+  return impl_->failure;
+}
 
 EmulatorCounters TrackerEmulator::counters() const {
   std::lock_guard lock(impl_->mutex);

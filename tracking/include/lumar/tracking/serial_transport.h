@@ -44,6 +44,8 @@ class SerialTransport final : public ByteTransport {
 
  private:
   struct Port;  // keeps LibSerial out of this header
+  // Closes and destroys a port, also one whose line hung up (see the .cpp).
+  static void close_port(std::unique_ptr<Port>& port);
   SerialSettings settings_;
   std::unique_ptr<Port> port_;
 };

@@ -110,6 +110,8 @@ class TrackerEmulator {
   std::string port_path() const;
   bool connected() const;
   EmulatorCounters counters() const;
+  // Why the device thread stopped on its own (an unexpected error); "" while it runs.
+  std::string failure() const;
 
   // Fault injection on demand. disconnect_for: the pty (and link) vanish now, queued
   // bytes are lost, and a new pty appears after `duration`. silence_for: the device hangs
