@@ -45,7 +45,7 @@ tracking::Device model_option(const std::string& name) {
   try {
     return tracking::parse_device(name);
   } catch (const InputError& e) {
-    throw InputError(std::string("--model: ") + e.what());
+    throw InputError(std::string("--device: ") + e.what());
   }
 }
 
@@ -139,7 +139,7 @@ void register_tracker_emulate(CLI::App& tracker) {
   auto o = std::make_shared<EmulateOptions>();
   auto* cmd = tracker.add_subcommand(
       "emulate", "Run an emulated ISOTRAK II / Fastrak on a pseudo-terminal (prints its path) until Ctrl-C");
-  cmd->add_option("--model", o->model, "Device: isotrak2 or fastrak")->capture_default_str();
+  cmd->add_option("--device", o->model, "Device: isotrak2 or fastrak")->capture_default_str();
   cmd->add_option("--link", o->link, "Also make this symlink to the pty (follows it across reconnections)");
   cmd->add_option("--baud", o->baud, "Line speed the output is paced at")->capture_default_str();
   cmd->add_option("--rate", o->rate_hz, "Records per second over all stations (0: 60 ISOTRAK II, 120 Fastrak)")

@@ -41,7 +41,7 @@ std::string port_from_device(const std::string& device) {
   const std::string prefix = "serial:";
   std::string path = device.rfind(prefix, 0) == 0 ? device.substr(prefix.size()) : device;
   if (path.empty() || path[0] != '/')
-    throw InputError("--device '" + device + "' is not a serial port; use serial:/dev/ttyUSB0 (see lumar devices)");
+    throw InputError("--port '" + device + "' is not a serial port; use serial:/dev/ttyUSB0 (see lumar devices)");
   return path;
 }
 
@@ -59,7 +59,7 @@ void run_record(const RecordOptions& o) {
   try {
     device = tracking::parse_device(o.model);
   } catch (const InputError& e) {
-    throw InputError(std::string("--model: ") + e.what());
+    throw InputError(std::string("--device: ") + e.what());
   }
   if (o.units != "in" && o.units != "cm") throw InputError("--units '" + o.units + "' is unknown; use in or cm");
   output.centimetres = o.units == "cm";
@@ -163,9 +163,9 @@ void run_record(const RecordOptions& o) {
 void register_tracker_record(CLI::App& tracker) {
   auto o = std::make_shared<RecordOptions>();
   auto* cmd = tracker.add_subcommand("record", "Record a tracker's raw bytes and decoded poses until Ctrl-C");
-  cmd->add_option("--device", o->device, "Serial port, e.g. serial:/dev/ttyUSB0")->required();
+  cmd->add_option("--port", o->device, "Serial port, e.g. serial:/dev/ttyUSB0")->required();
   cmd->add_option("--out", o->out, "Recording directory to create (must not exist)")->required();
-  cmd->add_option("--model", o->model, "Tracker: isotrak2 or fastrak")->capture_default_str();
+  cmd->add_option("--device", o->model, "Tracker: isotrak2 or fastrak")->capture_default_str();
   cmd->add_option("--baud", o->baud, "Line speed (the device's DIP switches)")->capture_default_str();
   cmd->add_flag("--rts-cts", o->rts_cts, "Hardware flow control");
   cmd->add_flag("--binary", o->binary, "Ask for binary records (`f`) instead of ASCII");

@@ -17,15 +17,7 @@
 namespace lumar::calib {
 namespace {
 
-// A scratch folder for one test, removed when the test ends.
-struct Scratch {
-  explicit Scratch(const std::string& name) : dir(test::scratch_dir(name)) {}
-  ~Scratch() {
-    std::error_code ignored;
-    std::filesystem::remove_all(dir, ignored);
-  }
-  std::filesystem::path dir;
-};
+using test::Scratch;
 
 std::vector<std::filesystem::path> board_images() {
   std::vector<std::filesystem::path> images;

@@ -50,7 +50,7 @@ case_devices_lists_or_says_none() {
 
 case_record_survives_kill_9() {
   start_emulator --rate 60
-  "$LUMAR" tracker record --device "serial:$TMP/tty" --out "$TMP/rec" >"$TMP/record.log" 2>&1 &
+  "$LUMAR" tracker record --port "serial:$TMP/tty" --out "$TMP/rec" >"$TMP/record.log" 2>&1 &
   local recorder=$!
   PIDS+=("$recorder")
   wait_for 15 at_least_lines "$TMP/rec/poses.csv" 61 || { cat "$TMP/record.log"; fail "no poses recorded"; }
@@ -84,8 +84,10 @@ case_record_survives_kill_9() {
 }
 
 case_record_rides_through_disconnections() {
-  start_emulator --rate 60 --disconnect-every 1.2 --disconnect-for 0.3
-  "$LUMAR" tracker record --device "serial:$TMP/tty" --out "$TMP/rec" --watchdog 0.5 --duration 3.5 \
+  # Outages at 2 s and 4 s after the emulator started (the recorder must find the port
+  # at its start, so the first outage leaves it time to start even on a loaded machine).
+  start_emulator --rate 60 --disconnect-every 2 --disconnect-for 0.3
+  "$LUMAR" tracker record --port "serial:$TMP/tty" --out "$TMP/rec" --watchdog 0.5 --duration 4.8 \
     >"$TMP/record.log" 2>&1 || { cat "$TMP/record.log"; fail "record failed"; }
   stop_emulator
   cat "$TMP/record.log"
@@ -98,7 +100,7 @@ case_record_rides_through_disconnections() {
 
 case_record_stops_cleanly_on_sigint() {
   start_emulator --rate 60
-  "$LUMAR" tracker record --device "serial:$TMP/tty" --out "$TMP/rec" >"$TMP/record.log" 2>&1 &
+  "$LUMAR" tracker record --port "serial:$TMP/tty" --out "$TMP/rec" >"$TMP/record.log" 2>&1 &
   local recorder=$!
   PIDS+=("$recorder")
   wait_for 15 at_least_lines "$TMP/rec/poses.csv" 11 || { cat "$TMP/record.log"; fail "no poses recorded"; }
@@ -110,12 +112,12 @@ case_record_stops_cleanly_on_sigint() {
 }
 
 case_bad_tracker_input() {
-  expect_bad_input "--model" "" -- "$LUMAR" tracker emulate --model polaris
+  expect_bad_input "--device" "" -- "$LUMAR" tracker emulate --device polaris
   expect_bad_input "/dev/lumar-no-such-port" "$TMP/rec" -- "$LUMAR" tracker record \
-    --device serial:/dev/lumar-no-such-port --out "$TMP/rec"
-  expect_bad_input "--list" "$TMP/rec" -- "$LUMAR" tracker record --device serial:/dev/null --out "$TMP/rec" --list 2,99
+    --port serial:/dev/lumar-no-such-port --out "$TMP/rec"
+  expect_bad_input "--list" "$TMP/rec" -- "$LUMAR" tracker record --port serial:/dev/null --out "$TMP/rec" --list 2,99
   expect_bad_input "nowhere.csv" "" -- "$LUMAR" tracker emulate --trajectory "$TMP/nowhere.csv"
-  expect_bad_input "/dev/null" "$TMP/rec" -- "$LUMAR" tracker record --device serial:/dev/null --out "$TMP/rec"
+  expect_bad_input "/dev/null" "$TMP/rec" -- "$LUMAR" tracker record --port serial:/dev/null --out "$TMP/rec"
 }
 
 run_case

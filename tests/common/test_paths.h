@@ -11,4 +11,16 @@ std::filesystem::path lumar_binary();
 // A fresh, empty directory for this test; removed by the caller if wanted.
 std::filesystem::path scratch_dir(const std::string& name);
 
+// A scratch folder for one test, removed when the test ends.
+struct Scratch {
+  explicit Scratch(const std::string& name) : dir(scratch_dir(name)) {}
+  ~Scratch() {
+    std::error_code ignored;
+    std::filesystem::remove_all(dir, ignored);
+  }
+  Scratch(const Scratch&) = delete;
+  Scratch& operator=(const Scratch&) = delete;
+  std::filesystem::path dir;
+};
+
 }  // namespace lumar::test

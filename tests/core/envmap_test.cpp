@@ -17,15 +17,7 @@
 namespace lumar {
 namespace {
 
-// A scratch folder for one test, removed when the test ends.
-struct Scratch {
-  explicit Scratch(const std::string& name) : dir(test::scratch_dir(name)) {}
-  ~Scratch() {
-    std::error_code ignored;
-    std::filesystem::remove_all(dir, ignored);
-  }
-  std::filesystem::path dir;
-};
+using test::Scratch;
 
 std::filesystem::path real_map(const std::string& name) {
   return test::shared_dir() / "data/envmaps" / (name + ".exr");

@@ -16,15 +16,7 @@
 namespace lumar {
 namespace {
 
-// A scratch folder for one test, removed when the test ends.
-struct Scratch {
-  explicit Scratch(const std::string& name) : dir(test::scratch_dir(name)) {}
-  ~Scratch() {
-    std::error_code ignored;
-    std::filesystem::remove_all(dir, ignored);
-  }
-  std::filesystem::path dir;
-};
+using test::Scratch;
 
 void write_text(const std::filesystem::path& path, const std::string& text) {
   std::ofstream(path, std::ios::binary) << text;

@@ -69,6 +69,17 @@ class StageClock {
   std::chrono::steady_clock::time_point last_;
 };
 
+// The bound framebuffer as floats, top row first (GL rows run bottom-up).
+cv::Mat read_float_pixels(int width, int height, GLenum format, int cv_type, const char* what) {
+  cv::Mat out(height, width, cv_type);
+  glPixelStorei(GL_PACK_ALIGNMENT, 4);
+  glPixelStorei(GL_PACK_ROW_LENGTH, 0);
+  glReadPixels(0, 0, width, height, format, GL_FLOAT, out.data);
+  check_gl_errors(what);
+  cv::flip(out, out, 0);
+  return out;
+}
+
 }  // namespace
 
 struct Renderer::Impl {
@@ -337,25 +348,14 @@ cv::Mat Renderer::render_room_radiance(const CameraIntrinsics& camera, const Pos
   r.room.draw();
   glDisable(GL_DEPTH_TEST);
 
-  cv::Mat out(camera.height, camera.width, CV_32FC3);
-  glPixelStorei(GL_PACK_ALIGNMENT, 4);
-  glPixelStorei(GL_PACK_ROW_LENGTH, 0);
-  glReadPixels(0, 0, out.cols, out.rows, GL_BGR, GL_FLOAT, out.data);
-  check_gl_errors("Renderer::render_room_radiance");
-  cv::flip(out, out, 0);  // GL rows run bottom-up
-  return out;
+  return read_float_pixels(camera.width, camera.height, GL_BGR, CV_32FC3, "Renderer::render_room_radiance");
 }
 
 cv::Mat Renderer::render_object_world_positions(const Pose& T_world_camera) {
   Impl& r = *impl_;
   r.draw_positions(T_world_camera);
-  cv::Mat out(r.camera.height, r.camera.width, CV_32FC4);
-  glPixelStorei(GL_PACK_ALIGNMENT, 4);
-  glPixelStorei(GL_PACK_ROW_LENGTH, 0);
-  glReadPixels(0, 0, out.cols, out.rows, GL_RGBA, GL_FLOAT, out.data);
-  check_gl_errors("Renderer::render_object_world_positions");
-  cv::flip(out, out, 0);  // GL rows run bottom-up
-  return out;
+  return read_float_pixels(r.camera.width, r.camera.height, GL_RGBA, CV_32FC4,
+                           "Renderer::render_object_world_positions");
 }
 
 cv::Mat Renderer::render_object_mask(const Pose& T_world_camera) {

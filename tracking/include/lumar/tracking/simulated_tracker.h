@@ -35,7 +35,8 @@ struct SimulatedTrackerOutput {
 
 // true_pose(t) gives T_transmitter_sensor at time t, for t in [0, duration].
 // Record k is measured at t_k = k / rate_hz (rounded to the ns) for every t_k <= duration.
-// Noise: rotation error exp(v) with v ~ N(0, sigma^2 I3), sigma = orientation_noise_deg / sqrt(3)
+// Noise (MeasurementNoise in measurement_model.h, shared with the emulator): rotation
+// error exp(v) with v ~ N(0, sigma^2 I3), sigma = orientation_noise_deg / sqrt(3)
 // (so the RMS error angle is the setting), applied in the transmitter frame; position
 // error ~ N(0, position_noise_m^2) per axis. Deterministic for a given seed
 // (std::mt19937_64, standard normals scaled by sigma).
