@@ -7,7 +7,7 @@
 #include <spdlog/spdlog.h>
 
 #include "commands.h"
-#include "lumar/calib/checkerboard_calibration.h"
+#include "lumar/calib/calibration_report.h"
 #include "lumar/core/error.h"
 
 namespace lumar::app {
@@ -20,6 +20,9 @@ struct CalibrateOptions {
   double square = 0.025;
   std::string out;
   bool json = false;
+  std::string coverage;
+  calib::RobustCalibrationOptions calib;
+  bool no_reject = false;
 };
 
 cv::Size parse_board(const std::string& text) {
@@ -57,20 +60,58 @@ void register_calibrate(CLI::App& app) {
   cmd->add_option("--square", o->square, "Square size in metres")->check(CLI::PositiveNumber)->capture_default_str();
   cmd->add_option("--out", o->out, "Calibration file to write (OpenCV YAML)")->required();
   cmd->add_flag("--json", o->json, "Print a machine-readable summary to stdout");
+  cmd->add_flag("--fix-k3", o->calib.fix_k3, "Keep k3 at 0 (narrow-angle lenses)");
+  cmd->add_flag("--fix-aspect", o->calib.fix_aspect, "Solve with fx = fy");
+  cmd->add_flag("--no-reject", o->no_reject, "Keep every view (no outlier rejection)");
+  cmd->add_option("--coverage", o->coverage, "Write a PNG of where the corners fell on the sensor");
   add_action(cmd, [o] {
-    const auto result = calib::calibrate_checkerboard(expand(o->images), parse_board(o->board), o->square);
-    calib::save_camera_file(o->out, result.camera);
+    const cv::Size board = parse_board(o->board);
+    const auto views = calib::detect_checkerboard_views(expand(o->images), board, o->square);
+    auto options = o->calib;
+    options.reject_outliers = !o->no_reject;
+    const auto result = calib::calibrate_robust(views, options);
+    if (!o->coverage.empty()) calib::write_coverage_image(o->coverage, views, result, options);
+    calib::save_calibration_report(o->out, result, board, o->square);
+    for (const auto& w : result.warnings) std::fprintf(stderr, "lumar: warning: %s\n", w.c_str());
     const auto& c = result.camera.intrinsics;
     if (o->json) {
+      nlohmann::json std_dev = nlohmann::json::object();
+      for (std::size_t i = 0; i < calib::kIntrinsicNames.size(); ++i) std_dev[calib::kIntrinsicNames[i]] = result.std_dev[i];
+      nlohmann::json rejected = nlohmann::json::array(), rejections = nlohmann::json::array();
+      for (const auto& v : result.rejected) {
+        rejected.push_back(v.name);
+        rejections.push_back({{"file", v.name}, {"rms", v.rms_px}, {"threshold", v.threshold_px}, {"round", v.round}});
+      }
       nlohmann::json j = {{"rms", result.camera.avg_reprojection_error},
+                          {"initial_rms", result.initial_rms},
                           {"fx", c.fx}, {"fy", c.fy}, {"cx", c.cx}, {"cy", c.cy},
-                          {"dist", c.distortion}, {"views_used", result.used_views.size()},
+                          {"dist", c.distortion}, {"std", std_dev},
+                          {"views_used", result.used_views.size()},
+                          {"used_views", result.used_views},
+                          {"views_rejected", rejected}, {"rejections", rejections},
                           {"views_without_board", result.views_without_board},
-                          {"per_view_rms", result.per_view_rms}};
+                          {"per_view_rms", result.per_view_rms},
+                          {"holdout_rms", result.holdout_rms}, {"holdout_training_rms", result.training_rms},
+                          {"holdout_splits", result.holdout_splits},
+                          {"coverage", result.coverage}, {"orientations", result.orientations},
+                          {"warnings", result.warnings}};
       std::printf("%s\n", j.dump(2).c_str());
     } else {
-      spdlog::info("calibrate: {} views, RMS {:.3f} px, fx {:.2f} fy {:.2f} cx {:.2f} cy {:.2f} -> {}",
-                   result.used_views.size(), result.camera.avg_reprojection_error, c.fx, c.fy, c.cx, c.cy, o->out);
+      spdlog::info("calibrate: {} views kept, {} rejected; RMS {:.3f} px (all views {:.3f} px) -> {}",
+                   result.used_views.size(), result.rejected.size(), result.camera.avg_reprojection_error,
+                   result.initial_rms, o->out);
+      spdlog::info("  fx {:.2f} ± {:.2f}  fy {:.2f} ± {:.2f}  cx {:.2f} ± {:.2f}  cy {:.2f} ± {:.2f}", c.fx,
+                   result.std_dev[0], c.fy, result.std_dev[1], c.cx, result.std_dev[2], c.cy, result.std_dev[3]);
+      spdlog::info("  k1 {:.4f} ± {:.4f}  k2 {:.4f} ± {:.4f}  p1 {:.5f} ± {:.5f}  p2 {:.5f} ± {:.5f}  k3 {:.4f} ± {:.4f}",
+                   c.distortion[0], result.std_dev[4], c.distortion[1], result.std_dev[5], c.distortion[2],
+                   result.std_dev[6], c.distortion[3], result.std_dev[7], c.distortion[4], result.std_dev[8]);
+      spdlog::info("  held-out RMS {:.3f} px over {} half/half splits (training halves {:.3f} px); coverage {:.0f}%, "
+                   "{} board orientations",
+                   result.holdout_rms, result.holdout_splits, result.training_rms, 100 * result.coverage,
+                   result.orientations);
+      for (const auto& v : result.rejected)
+        spdlog::info("  rejected {}: {:.3f} px > threshold {:.3f} px (round {})", v.name, v.rms_px, v.threshold_px,
+                     v.round);
       for (std::size_t i = 0; i < result.used_views.size(); ++i)
         spdlog::info("  {}: {:.3f} px", result.used_views[i], result.per_view_rms[i]);
     }

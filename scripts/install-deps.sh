@@ -17,6 +17,7 @@ packages=(
   zlib1g-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   xvfb xauth                         # window tests under xvfb-run
+  python3                            # JSON checks in the command-line tests
 )
 
 missing=()

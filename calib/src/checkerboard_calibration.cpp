@@ -15,8 +15,16 @@ std::string size_text(cv::Size s) { return std::to_string(s.width) + "x" + std::
 
 }  // namespace
 
-CalibrationResult calibrate_checkerboard(const std::vector<std::filesystem::path>& images,
-                                         cv::Size inner_corners, double square_size_m) {
+std::vector<cv::Point3f> checkerboard_points(cv::Size inner_corners, double square_size_m) {
+  std::vector<cv::Point3f> board;
+  for (int r = 0; r < inner_corners.height; ++r)
+    for (int c = 0; c < inner_corners.width; ++c)
+      board.emplace_back(float(c * square_size_m), float(r * square_size_m), 0.f);
+  return board;
+}
+
+CheckerboardViews detect_checkerboard_views(const std::vector<std::filesystem::path>& images,
+                                            cv::Size inner_corners, double square_size_m) {
   if (images.empty()) throw InputError("checkerboard calibration: no images given; pass the board photographs");
   if (inner_corners.width < 2 || inner_corners.height < 2)
     throw InputError("checkerboard calibration: board size " + size_text(inner_corners) +
@@ -24,15 +32,10 @@ CalibrationResult calibrate_checkerboard(const std::vector<std::filesystem::path
   if (!(square_size_m > 0.0) || !std::isfinite(square_size_m))
     throw InputError("checkerboard calibration: square size must be a positive length in metres");
 
-  // The board's corners in its own plane, row by row as findChessboardCorners orders them.
-  std::vector<cv::Point3f> board;
-  for (int r = 0; r < inner_corners.height; ++r)
-    for (int c = 0; c < inner_corners.width; ++c)
-      board.emplace_back(float(c * square_size_m), float(r * square_size_m), 0.f);
-
-  CalibrationResult result;
-  std::vector<std::vector<cv::Point2f>> image_points;
-  cv::Size image_size;
+  CheckerboardViews result;
+  result.board = checkerboard_points(inner_corners, square_size_m);
+  auto& image_points = result.corners;
+  cv::Size& image_size = result.image_size;
   std::string first_image;
   for (const auto& path : images) {
     const std::string name = path.string();
@@ -58,7 +61,7 @@ CalibrationResult calibrate_checkerboard(const std::vector<std::filesystem::path
     cv::cornerSubPix(gray, corners, cv::Size(11, 11), cv::Size(-1, -1),
                      cv::TermCriteria(cv::TermCriteria::EPS | cv::TermCriteria::COUNT, 30, 0.0001));
     image_points.push_back(std::move(corners));
-    result.used_views.push_back(name);
+    result.names.push_back(name);
   }
   if (image_points.empty())
     throw InputError("checkerboard calibration: no " + size_text(inner_corners) +
@@ -69,6 +72,18 @@ CalibrationResult calibrate_checkerboard(const std::vector<std::filesystem::path
                      std::to_string(image_points.size()) + " image(s); at least 3 views are needed, "
                      "better 10 or more at varied angles");
 
+  return result;
+}
+
+CalibrationResult calibrate_checkerboard(const std::vector<std::filesystem::path>& images,
+                                         cv::Size inner_corners, double square_size_m) {
+  const CheckerboardViews views = detect_checkerboard_views(images, inner_corners, square_size_m);
+  const auto& board = views.board;
+  const auto& image_points = views.corners;
+  const cv::Size image_size = views.image_size;
+  CalibrationResult result;
+  result.used_views = views.names;
+  result.views_without_board = views.views_without_board;
   const std::vector<std::vector<cv::Point3f>> object_points(image_points.size(), board);
   cv::Mat K, D;
   std::vector<cv::Mat> rvecs, tvecs;

@@ -1,0 +1,82 @@
+# lumar calibrate on the 13 shared checkerboard photographs: the JSON summary, the
+# report file, the coverage image, the options, and bad input (exit 2, one line).
+source "$(dirname "$0")/lib.sh"
+BOARDS=$SHARED/data/calib/checkerboard-9x6
+
+# json_check PYTHON_EXPRESSION: evaluated with j = the parsed stdout of the last run.
+json_check() {
+  python3 -c "import json,sys; j=json.load(open('$TMP/out.json')); sys.exit(0 if ($1) else 1)" ||
+    { cat "$TMP/out.json" >&2; fail "JSON check failed: $1"; }
+}
+
+case_json_summary() {
+  "$LUMAR" calibrate --images "$BOARDS/*.jpg" --out "$TMP/cam.yml" --coverage "$TMP/coverage.png" --json \
+    >"$TMP/out.json" 2>"$TMP/stderr" || { cat "$TMP/stderr" >&2; fail "calibrate failed"; }
+  for key in rms fx fy cx cy dist views_used views_rejected std holdout_rms coverage; do
+    json_check "'$key' in j"
+  done
+  json_check "len(j['dist']) == 5 and all(isinstance(x, float) for x in j['dist'])"
+  json_check "j['views_used'] + len(j['views_rejected']) == 13"
+  json_check "[n.split('/')[-1] for n in j['views_rejected']][:1] == ['left02.jpg']"
+  json_check "j['rms'] <= 0.25 and abs(j['initial_rms'] - 0.409) < 0.01"
+  json_check "all(j['std'][k] > 0 for k in ['fx','fy','cx','cy','k1','k2','p1','p2','k3'])"
+  json_check "0 < j['holdout_rms'] < 0.5"
+  # The YAML is a camera file other commands read, with the statistics beside it.
+  grep -q '^camera_matrix:' "$TMP/cam.yml" || fail "no camera_matrix in the YAML"
+  grep -q '^std_deviations_intrinsics:' "$TMP/cam.yml" || fail "no standard deviations in the YAML"
+  grep -q 'left02.jpg' "$TMP/cam.yml" || fail "rejected view not named in the YAML"
+  [ "$(head -c 8 "$TMP/coverage.png" | od -An -tx1 | tr -d ' \n')" = "89504e470d0a1a0a" ] || fail "coverage is not a PNG"
+  [ ! -e "$TMP/cam.yml.tmp" ] || fail "temporary file left behind"
+  python3 -c "import json; j=json.load(open('$TMP/out.json')); print('ok: rms %.3f (all %.3f), rejected %s, held-out %.3f, coverage %.2f' % (j['rms'], j['initial_rms'], j['views_rejected'], j['holdout_rms'], j['coverage']))"
+}
+
+case_no_reject_and_fix_flags() {
+  "$LUMAR" calibrate --images "$BOARDS/*.jpg" --out "$TMP/cam.yml" --no-reject --fix-k3 --fix-aspect --json \
+    >"$TMP/out.json" 2>"$TMP/stderr" || { cat "$TMP/stderr" >&2; fail "calibrate failed"; }
+  json_check "j['views_rejected'] == [] and j['views_used'] == 13"
+  json_check "j['dist'][4] == 0 and abs(j['fx'] - j['fy']) < 1e-6 * j['fx']"
+}
+
+case_plain_output_still_works() {
+  # The original options, without --json: a log on stdout and a camera file.
+  "$LUMAR" calibrate --images "$BOARDS/left0*.jpg" --board 9x6 --square 0.025 --out "$TMP/cam.yml" \
+    >"$TMP/stdout" 2>"$TMP/stderr" || { cat "$TMP/stderr" >&2; fail "calibrate failed"; }
+  grep -q 'RMS' "$TMP/stdout" || fail "no summary on stdout"
+  grep -q '^avg_reprojection_error:' "$TMP/cam.yml" || fail "no avg_reprojection_error in the YAML"
+}
+
+case_wrong_board_size() {
+  expect_bad_input "no 7x5" "$TMP/cam.yml" -- \
+    "$LUMAR" calibrate --images "$BOARDS/left0*.jpg" --board 7x5 --out "$TMP/cam.yml"
+}
+
+case_no_board_in_any_image() {
+  python3 -c "import zlib,struct
+def chunk(t,d): return struct.pack('>I',len(d))+t+d+struct.pack('>I',zlib.crc32(t+d)&0xffffffff)
+raw=b''.join(b'\x00'+b'\x80'*64 for _ in range(48))
+open('$TMP/blank.png','wb').write(b'\x89PNG\r\n\x1a\n'+chunk(b'IHDR',struct.pack('>IIBBBBB',64,48,8,0,0,0,0))+chunk(b'IDAT',zlib.compress(raw))+chunk(b'IEND',b''))"
+  expect_bad_input "no 9x6" "$TMP/cam.yml" -- \
+    "$LUMAR" calibrate --images "$TMP/blank.png" --out "$TMP/cam.yml"
+}
+
+case_too_few_views() {
+  expect_bad_input "at least 3" "$TMP/cam.yml" -- \
+    "$LUMAR" calibrate --images "$BOARDS/left01.jpg" --images "$BOARDS/left03.jpg" --out "$TMP/cam.yml"
+}
+
+case_unreadable_image() {
+  printf 'not a jpeg' >"$TMP/broken.jpg"
+  expect_bad_input "$TMP/broken.jpg" "$TMP/cam.yml" -- \
+    "$LUMAR" calibrate --images "$BOARDS/left01.jpg" "$TMP/broken.jpg" --out "$TMP/cam.yml"
+}
+
+case_images_of_different_sizes() {
+  python3 -c "import zlib,struct
+def chunk(t,d): return struct.pack('>I',len(d))+t+d+struct.pack('>I',zlib.crc32(t+d)&0xffffffff)
+raw=b''.join(b'\x00'+b'\x80'*64 for _ in range(48))
+open('$TMP/small.png','wb').write(b'\x89PNG\r\n\x1a\n'+chunk(b'IHDR',struct.pack('>IIBBBBB',64,48,8,0,0,0,0))+chunk(b'IDAT',zlib.compress(raw))+chunk(b'IEND',b''))"
+  expect_bad_input "$TMP/small.png" "$TMP/cam.yml" -- \
+    "$LUMAR" calibrate --images "$BOARDS/left01.jpg" "$TMP/small.png" --out "$TMP/cam.yml"
+}
+
+run_case
