@@ -41,6 +41,22 @@ int poll_timeout_ms(Nanos timeout) {
   return int(std::min<Nanos>((timeout + 999'999) / 1'000'000, 1'000'000));
 }
 
+// Waits until `fd` is ready for `events` or `timeout` has passed (returns 0 then),
+// riding over signals; a hang-up is the device vanishing.
+short wait_for(int fd, short events, Nanos timeout, const std::string& path) {
+  const Nanos deadline = monotonic_now() + std::max<Nanos>(timeout, 0);
+  pollfd p{fd, events, 0};
+  int ready;
+  for (;;) {
+    ready = ::poll(&p, 1, poll_timeout_ms(deadline - monotonic_now()));
+    if (ready >= 0 || errno != EINTR) break;
+  }
+  if (ready < 0) throw RuntimeError(path + ": poll failed (" + std::strerror(errno) + ")");
+  if (p.revents & (POLLHUP | POLLERR | POLLNVAL))
+    throw DeviceVanished(path + ": the device hung up or was unplugged");
+  return ready == 0 ? 0 : p.revents;
+}
+
 }  // namespace
 
 struct SerialTransport::Port {
@@ -143,18 +159,9 @@ void SerialTransport::close_port(std::unique_ptr<Port>& port_) {
 ByteChunk SerialTransport::read(Nanos timeout) {
   const std::string& path = settings_.path;
   if (!port_) throw DeviceVanished(path + ": the port is closed");
-  const Nanos deadline = monotonic_now() + std::max<Nanos>(timeout, 0);
-  pollfd p{port_->fd, POLLIN, 0};
-  int ready;
-  for (;;) {
-    ready = ::poll(&p, 1, poll_timeout_ms(deadline - monotonic_now()));
-    if (ready >= 0 || errno != EINTR) break;
-  }
-  if (ready < 0) throw RuntimeError(path + ": poll failed (" + std::strerror(errno) + ")");
-  if (p.revents & (POLLHUP | POLLERR | POLLNVAL))
-    throw DeviceVanished(path + ": the device hung up or was unplugged");
+  const short revents = wait_for(port_->fd, POLLIN, timeout, path);
   ByteChunk chunk;
-  if (ready == 0 || !(p.revents & POLLIN)) {
+  if (!(revents & POLLIN)) {
     chunk.arrival = monotonic_now();
     return chunk;
   }
@@ -184,17 +191,7 @@ void SerialTransport::write(std::string_view bytes, Nanos timeout) {
   const std::string& path = settings_.path;
   if (!port_) throw DeviceVanished(path + ": the port is closed");
   if (bytes.empty()) return;
-  const Nanos deadline = monotonic_now() + std::max<Nanos>(timeout, 0);
-  pollfd p{port_->fd, POLLOUT, 0};
-  int ready;
-  for (;;) {
-    ready = ::poll(&p, 1, poll_timeout_ms(deadline - monotonic_now()));
-    if (ready >= 0 || errno != EINTR) break;
-  }
-  if (ready < 0) throw RuntimeError(path + ": poll failed (" + std::strerror(errno) + ")");
-  if (p.revents & (POLLHUP | POLLERR | POLLNVAL))
-    throw DeviceVanished(path + ": the device hung up or was unplugged");
-  if (ready == 0)
+  if (!(wait_for(port_->fd, POLLOUT, timeout, path) & POLLOUT))
     throw RuntimeError(path + ": cannot send for " + std::to_string(timeout / 1'000'000) +
                        " ms; the output is blocked (check RTS/CTS wiring or turn --rts-cts off)");
   try {
