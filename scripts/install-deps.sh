@@ -9,7 +9,7 @@ packages=(
   libembree-dev                      # ray queries (Embree 3)
   libopenimageio-dev                 # EXR / HDR environment maps
   libglfw3-dev libglm-dev libepoxy-dev libegl-dev libegl1-mesa-dev libx11-dev
-  libgl1-mesa-dri                    # Mesa llvmpipe: OpenGL 4.5 core without a GPU
+  libgl1-mesa-dri libegl-mesa0 libglx-mesa0   # Mesa llvmpipe: OpenGL 4.5 core without a GPU
   libserial-dev libusb-1.0-0-dev libv4l-dev
   libtbb-dev
   libcli11-dev nlohmann-json3-dev libspdlog-dev libfmt-dev
