@@ -19,17 +19,9 @@ namespace {
 
 using test::Scratch;
 
-std::vector<std::filesystem::path> board_images() {
-  std::vector<std::filesystem::path> images;
-  for (const auto& entry : std::filesystem::directory_iterator(test::shared_dir() / "data/calib/checkerboard-9x6"))
-    if (entry.path().extension() == ".jpg") images.push_back(entry.path());
-  std::sort(images.begin(), images.end());
-  return images;
-}
-
 // Calibrated once per test run; several tests look at the same result.
 const CalibrationResult& shared_result() {
-  static const CalibrationResult result = calibrate_checkerboard(board_images(), {9, 6}, 0.025);
+  static const CalibrationResult result = calibrate_checkerboard(test::checkerboard_images(), {9, 6}, 0.025);
   return result;
 }
 
@@ -45,7 +37,7 @@ void expect_input_error(const std::function<void()>& call, const std::string& ne
 
 TEST(CheckerboardCalibration, RealImagesGiveTheKnownErrors) {
   const CalibrationResult& r = shared_result();
-  ASSERT_EQ(board_images().size(), 13u);
+  ASSERT_EQ(test::checkerboard_images().size(), 13u);
   ASSERT_EQ(r.used_views.size(), 13u);
   EXPECT_TRUE(r.views_without_board.empty());
   ASSERT_EQ(r.per_view_rms.size(), 13u);
@@ -91,7 +83,7 @@ TEST(CheckerboardCalibration, ViewsWithoutTheBoardAreListed) {
   const Scratch scratch("calib-blank");
   const auto& dir = scratch.dir;
   cv::imwrite((dir / "blank.png").string(), cv::Mat(480, 640, CV_8U, cv::Scalar(128)));
-  auto images = board_images();
+  auto images = test::checkerboard_images();
   images.resize(4);
   images.push_back(dir / "blank.png");
   const CalibrationResult r = calibrate_checkerboard(images, {9, 6}, 0.025);
@@ -103,7 +95,7 @@ TEST(CheckerboardCalibration, ViewsWithoutTheBoardAreListed) {
 TEST(CheckerboardCalibration, ErrorCases) {
   const Scratch scratch("calib-errors");
   const auto& dir = scratch.dir;
-  auto images = board_images();
+  auto images = test::checkerboard_images();
 
   expect_input_error([&] { calibrate_checkerboard({}, {9, 6}, 0.025); }, "no images");
 

@@ -19,16 +19,8 @@
 namespace lumar::calib {
 namespace {
 
-std::vector<std::filesystem::path> board_images() {
-  std::vector<std::filesystem::path> images;
-  for (const auto& entry : std::filesystem::directory_iterator(test::shared_dir() / "data/calib/checkerboard-9x6"))
-    if (entry.path().extension() == ".jpg") images.push_back(entry.path());
-  std::sort(images.begin(), images.end());
-  return images;
-}
-
 const CheckerboardViews& real_views() {
-  static const CheckerboardViews views = detect_checkerboard_views(board_images(), {9, 6}, 0.025);
+  static const CheckerboardViews views = detect_checkerboard_views(test::checkerboard_images(), {9, 6}, 0.025);
   return views;
 }
 
@@ -97,7 +89,7 @@ TEST(RobustCalibration, StandardDeviationsArePositiveAndPlausible) {
   for (std::size_t i = 4; i < 9; ++i) EXPECT_LT(r.std_dev[i], 1.0) << kIntrinsicNames[i];
   // Dropping one view of 13 must not move fx by more than a couple of percent (it
   // moves 1.9 px, about 2 sigma); a bigger jump would mean the solve went elsewhere.
-  const CalibrationResult plain = calibrate_checkerboard(board_images(), {9, 6}, 0.025);
+  const CalibrationResult plain = calibrate_checkerboard(test::checkerboard_images(), {9, 6}, 0.025);
   EXPECT_LT(std::abs(plain.camera.intrinsics.fx - c.fx), 0.02 * c.fx);
 }
 
@@ -120,7 +112,7 @@ TEST(RobustCalibration, NoRejectIsThePlainSolve) {
   RobustCalibrationOptions o;
   o.reject_outliers = false;
   const RobustCalibrationResult r = calibrate_robust(real_views(), o);
-  const CalibrationResult plain = calibrate_checkerboard(board_images(), {9, 6}, 0.025);
+  const CalibrationResult plain = calibrate_checkerboard(test::checkerboard_images(), {9, 6}, 0.025);
   EXPECT_TRUE(r.rejected.empty());
   EXPECT_EQ(r.used_views.size(), 13u);
   EXPECT_NEAR(r.camera.avg_reprojection_error, plain.camera.avg_reprojection_error, 1e-9);

@@ -2,11 +2,21 @@
 
 #include <unistd.h>
 
+#include <algorithm>
+
 namespace lumar::test {
 
 std::filesystem::path source_dir() { return LUMAR_SOURCE_DIR; }
 std::filesystem::path shared_dir() { return LUMAR_SHARED_DIR; }
 std::filesystem::path lumar_binary() { return LUMAR_BINARY; }
+
+std::vector<std::filesystem::path> checkerboard_images() {
+  std::vector<std::filesystem::path> images;
+  for (const auto& entry : std::filesystem::directory_iterator(shared_dir() / "data/calib/checkerboard-9x6"))
+    if (entry.path().extension() == ".jpg") images.push_back(entry.path());
+  std::sort(images.begin(), images.end());
+  return images;
+}
 
 std::filesystem::path scratch_dir(const std::string& name) {
   auto dir = std::filesystem::temp_directory_path() /

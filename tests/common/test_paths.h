@@ -2,12 +2,15 @@
 // Paths the tests need: the checkout, ../shared beside it, the lumar binary, scratch space.
 #include <filesystem>
 #include <string>
+#include <vector>
 
 namespace lumar::test {
 
 std::filesystem::path source_dir();
 std::filesystem::path shared_dir();
 std::filesystem::path lumar_binary();
+// The 13 shared photographs of the 9x6 checkerboard, sorted by name.
+std::vector<std::filesystem::path> checkerboard_images();
 // A fresh, empty directory for this test; removed by the caller if wanted.
 std::filesystem::path scratch_dir(const std::string& name);
 
