@@ -50,11 +50,16 @@ case_wrong_board_size() {
     "$LUMAR" calibrate --images "$BOARDS/left0*.jpg" --board 7x5 --out "$TMP/cam.yml"
 }
 
-case_no_board_in_any_image() {
+# A plain grey 64x48 PNG (no board, and a size unlike the photographs).
+write_grey_png() {
   python3 -c "import zlib,struct
 def chunk(t,d): return struct.pack('>I',len(d))+t+d+struct.pack('>I',zlib.crc32(t+d)&0xffffffff)
 raw=b''.join(b'\x00'+b'\x80'*64 for _ in range(48))
-open('$TMP/blank.png','wb').write(b'\x89PNG\r\n\x1a\n'+chunk(b'IHDR',struct.pack('>IIBBBBB',64,48,8,0,0,0,0))+chunk(b'IDAT',zlib.compress(raw))+chunk(b'IEND',b''))"
+open('$1','wb').write(b'\x89PNG\r\n\x1a\n'+chunk(b'IHDR',struct.pack('>IIBBBBB',64,48,8,0,0,0,0))+chunk(b'IDAT',zlib.compress(raw))+chunk(b'IEND',b''))"
+}
+
+case_no_board_in_any_image() {
+  write_grey_png "$TMP/blank.png"
   expect_bad_input "no 9x6" "$TMP/cam.yml" -- \
     "$LUMAR" calibrate --images "$TMP/blank.png" --out "$TMP/cam.yml"
 }
@@ -71,10 +76,7 @@ case_unreadable_image() {
 }
 
 case_images_of_different_sizes() {
-  python3 -c "import zlib,struct
-def chunk(t,d): return struct.pack('>I',len(d))+t+d+struct.pack('>I',zlib.crc32(t+d)&0xffffffff)
-raw=b''.join(b'\x00'+b'\x80'*64 for _ in range(48))
-open('$TMP/small.png','wb').write(b'\x89PNG\r\n\x1a\n'+chunk(b'IHDR',struct.pack('>IIBBBBB',64,48,8,0,0,0,0))+chunk(b'IDAT',zlib.compress(raw))+chunk(b'IEND',b''))"
+  write_grey_png "$TMP/small.png"
   expect_bad_input "$TMP/small.png" "$TMP/cam.yml" -- \
     "$LUMAR" calibrate --images "$BOARDS/left01.jpg" "$TMP/small.png" --out "$TMP/cam.yml"
 }
