@@ -4,10 +4,13 @@
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <opencv2/core/utility.hpp>
+#include <opencv2/imgcodecs.hpp>
 #include <spdlog/spdlog.h>
 
 #include "commands.h"
 #include "lumar/calib/calibration_report.h"
+#include "lumar/calib/charuco_calibration.h"
+#include "lumar/calib/video_views.h"
 #include "lumar/core/error.h"
 
 namespace lumar::app {
@@ -23,6 +26,11 @@ struct CalibrateOptions {
   std::string coverage;
   calib::RobustCalibrationOptions calib;
   bool no_reject = false;
+  std::string video;  // --video FILE --every N instead of --images
+  int every = 10;
+  std::string charuco;  // --charuco SQUARESxSQUARES: a ChArUco board instead of a checkerboard
+  double marker = 0.0;
+  std::string dict = "DICT_5X5_100";
 };
 
 cv::Size parse_board(const std::string& text) {
@@ -50,12 +58,57 @@ std::vector<std::filesystem::path> expand(const std::vector<std::string>& patter
   return out;
 }
 
+// ChArUco: cv::aruco::calibrateCameraCharuco on every view holding enough corners.
+void run_charuco(const CalibrateOptions& o) {
+  const cv::Size squares = parse_board(o.charuco);
+  if (!(o.marker > 0)) throw InputError("--charuco: give the marker side with --marker (metres)");
+  const calib::CharucoBoardSpec spec{squares.width, squares.height, o.square, o.marker, o.dict};
+  std::vector<calib::NamedImage> images;
+  if (!o.video.empty()) {
+    images = calib::sample_video_frames(o.video, o.every);
+  } else {
+    for (const auto& path : expand(o.images)) {
+      cv::Mat image = cv::imread(path.string(), cv::IMREAD_GRAYSCALE);
+      if (image.empty()) throw InputError(path.string() + ": cannot read image; check the path or remove it");
+      images.push_back({path.string(), image});
+    }
+  }
+  std::vector<cv::Mat> mats;
+  for (const auto& i : images) mats.push_back(i.image);
+  const auto result = calib::calibrate_charuco(mats, spec);
+  calib::save_camera_file(o.out, result.camera);
+  const auto& c = result.camera.intrinsics;
+  if (o.json) {
+    nlohmann::json std_dev = nlohmann::json::object();
+    for (std::size_t i = 0; i < calib::kIntrinsicNames.size(); ++i) std_dev[calib::kIntrinsicNames[i]] = result.std_dev[i];
+    nlohmann::json used = nlohmann::json::array();
+    for (int i : result.used_views) used.push_back(images[std::size_t(i)].name);
+    std::printf("%s\n", nlohmann::json({{"rms", result.camera.avg_reprojection_error}, {"fx", c.fx}, {"fy", c.fy},
+                                        {"cx", c.cx}, {"cy", c.cy}, {"dist", c.distortion}, {"std", std_dev},
+                                        {"views_used", result.used_views.size()}, {"used_views", used},
+                                        {"views_rejected", nlohmann::json::array()},
+                                        {"per_view_rms", result.per_view_rms}})
+                               .dump(2)
+                               .c_str());
+  } else {
+    spdlog::info("calibrate: ChArUco board in {} of {} views; RMS {:.3f} px -> {}", result.used_views.size(),
+                 images.size(), result.camera.avg_reprojection_error, o.out);
+    spdlog::info("  fx {:.2f} ± {:.2f}  fy {:.2f} ± {:.2f}  cx {:.2f} ± {:.2f}  cy {:.2f} ± {:.2f}", c.fx,
+                 result.std_dev[0], c.fy, result.std_dev[1], c.cx, result.std_dev[2], c.cy, result.std_dev[3]);
+  }
+}
+
 }  // namespace
 
 void register_calibrate(CLI::App& app) {
   auto o = std::make_shared<CalibrateOptions>();
   auto* cmd = app.add_subcommand("calibrate", "Calibrate camera intrinsics from checkerboard images");
-  cmd->add_option("--images", o->images, "Image files or glob patterns (quote globs)")->required();
+  cmd->add_option("--images", o->images, "Image files or glob patterns (quote globs)");
+  cmd->add_option("--video", o->video, "A video file of the board instead of --images");
+  cmd->add_option("--every", o->every, "--video: use every Nth frame")->check(CLI::PositiveNumber)->capture_default_str();
+  cmd->add_option("--charuco", o->charuco, "A ChArUco board of SQUARESxSQUARES (squares, not corners) instead of --board");
+  cmd->add_option("--marker", o->marker, "--charuco: marker side in metres")->check(CLI::PositiveNumber);
+  cmd->add_option("--dict", o->dict, "--charuco: ArUco dictionary")->capture_default_str();
   cmd->add_option("--board", o->board, "Inner corners of the board, WxH")->capture_default_str();
   cmd->add_option("--square", o->square, "Square size in metres")->check(CLI::PositiveNumber)->capture_default_str();
   cmd->add_option("--out", o->out, "Calibration file to write (OpenCV YAML)")->required();
@@ -65,8 +118,16 @@ void register_calibrate(CLI::App& app) {
   cmd->add_flag("--no-reject", o->no_reject, "Keep every view (no outlier rejection)");
   cmd->add_option("--coverage", o->coverage, "Write a PNG of where the corners fell on the sensor");
   add_action(cmd, [o] {
+    if (o->images.empty() == o->video.empty()) throw InputError("calibrate: give either --images or --video");
+    if (!o->charuco.empty()) {
+      run_charuco(*o);
+      return;
+    }
     const cv::Size board = parse_board(o->board);
-    const auto views = calib::detect_checkerboard_views(expand(o->images), board, o->square);
+    const auto views = o->video.empty()
+                           ? calib::detect_checkerboard_views(expand(o->images), board, o->square)
+                           : calib::detect_checkerboard_views(calib::sample_video_frames(o->video, o->every), board,
+                                                              o->square);
     auto options = o->calib;
     options.reject_outliers = !o->no_reject;
     const auto result = calib::calibrate_robust(views, options);

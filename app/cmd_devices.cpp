@@ -1,8 +1,9 @@
 // lumar devices: what a tracker could be plugged into: serial ports, Polhemus USB
-// devices (vendor 0x0f44) and USB-serial adapters.
+// devices (vendor 0x0f44) and USB-serial adapters; and the V4L2 cameras.
 #include <cstdio>
 
 #include "commands.h"
+#include "lumar/capture/v4l2_device.h"
 #include "lumar/tracking/device_enumeration.h"
 
 namespace lumar::app {
@@ -33,6 +34,18 @@ void run_devices() {
     std::printf("  none\n");
   for (const auto& d : inv.usb_serial) print_usb(d);
 
+  std::printf("V4L2 cameras:\n");
+  const auto device = capture::libv4l2_device();
+  const auto cameras = capture::list_v4l2_devices(*device);
+  if (cameras.empty()) std::printf("  none (no /dev/video*)\n");
+  for (const auto& c : cameras) {
+    if (!c.problem.empty())
+      std::printf("  %-16s %s\n", c.path.c_str(), c.problem.c_str());
+    else
+      std::printf("  %-16s %s (%s, %s)%s\n", c.path.c_str(), c.card.c_str(), c.driver.c_str(), c.bus.c_str(),
+                  c.video_capture && c.streaming ? "" : "  [not a streaming capture node]");
+  }
+
   if (inv.polhemus.empty() && inv.usb_serial.empty())
     std::printf("No tracker hardware found. An ISOTRAK II is RS-232 only: connect it to a serial port or a "
                 "USB-serial adapter. To try the software without one: lumar tracker emulate --link /tmp/isotrak\n");
@@ -41,7 +54,7 @@ void run_devices() {
 }  // namespace
 
 void register_devices(CLI::App& app) {
-  auto* cmd = app.add_subcommand("devices", "List serial ports, Polhemus USB devices and USB-serial adapters");
+  auto* cmd = app.add_subcommand("devices", "List serial ports, Polhemus USB devices, USB-serial adapters and V4L2 cameras");
   add_action(cmd, [] { run_devices(); });
 }
 

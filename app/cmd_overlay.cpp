@@ -6,13 +6,14 @@
 #include "commands.h"
 #include "lumar/core/error.h"
 #include "output_files.h"
+#include "live_overlay.h"
 #include "replay_overlay.h"
 
 namespace lumar::app {
 
 namespace {
 struct OverlayOptions {
-  std::string recording, scene, out, frames_dir, contact_sheet, poses = "tracker";
+  std::string recording, scene, out, frames_dir, contact_sheet, poses = "tracker", undistort = "same";
   bool window = false;
   int max_frames = 0;
 };
@@ -21,24 +22,41 @@ struct OverlayOptions {
 void register_overlay(CLI::App& app) {
   auto o = std::make_shared<OverlayOptions>();
   auto* cmd = app.add_subcommand("overlay", "Composite virtual objects into a recording's video (headless or in a window)");
-  cmd->add_option("--recording", o->recording, "Recording directory (video + tracker stream + session.json)")
-      ->required();
+  cmd->add_option("--recording", o->recording, "Recording directory (video + tracker stream + session.json)");
+  // The live path (live_overlay.h): --source and --tracker instead of --recording.
+  auto live = std::make_shared<LiveOverlayOptions>();
+  cmd->add_option("--source", live->in.source, "Live: video:FILE, images:DIR, v4l2:/dev/videoN or recording:DIR");
+  cmd->add_option("--rig", live->rig, "Live: a session.json whose rig (transmitter, camera offset) to use");
+  add_live_input_options(cmd, live->in);
   cmd->add_option("--scene", o->scene, "Scene manifest; default: the one the recording's session names");
   cmd->add_option("--out", o->out, "Output video (.mp4, .mkv or .avi)");
   cmd->add_option("--frames-dir", o->frames_dir, "Also write every output frame as PNG into this new folder");
   cmd->add_option("--contact-sheet", o->contact_sheet, "Also write 8 frames spread over the run, tiled, as one PNG");
   cmd->add_option("--poses", o->poses, "Camera poses from the tracker stream or from the recording's ground truth")
       ->check(CLI::IsMember({"tracker", "truth"}))->capture_default_str();
+  cmd->add_option("--undistort", o->undistort,
+                  "Output camera: 'same' keeps the calibrated matrix, 'crop' shows only valid pixels, 'keep' every input pixel")
+      ->check(CLI::IsMember({"same", "crop", "keep"}))->capture_default_str();
   cmd->add_flag("--window", o->window, "Show the result in a window (needs a display)");
   cmd->add_option("--max-frames", o->max_frames, "Stop after this many frames (0 = all)")->capture_default_str();
-  add_action(cmd, [o] {
+  add_action(cmd, [o, live] {
+    if (!live->in.source.empty()) {
+      if (!o->recording.empty()) throw InputError("overlay: give --recording or --source, not both");
+      live->scene = o->scene;
+      live->max_frames = o->max_frames;
+      return run_live_overlay(*live);
+    }
+    if (o->recording.empty()) throw InputError("overlay: give --recording DIR, or --source SPEC for the live path");
     if (o->out.empty() && o->frames_dir.empty() && o->contact_sheet.empty() && !o->window)
       throw InputError("overlay: nothing to do; give --out, --frames-dir, --contact-sheet or --window");
     if (!o->contact_sheet.empty() && std::filesystem::path(o->contact_sheet).extension() != ".png")
       throw InputError(o->contact_sheet + ": the contact sheet must be a .png file");
+    const auto undistortion = o->undistort == "crop"   ? calib::UndistortedCamera::CropToValid
+                              : o->undistort == "keep" ? calib::UndistortedCamera::KeepAll
+                                                       : calib::UndistortedCamera::SameMatrix;
     ReplayOverlay overlay(o->recording, o->scene, o->poses == "truth" ? PoseSource::Truth : PoseSource::Tracker,
-                          o->window);
-    const auto& camera = overlay.replay().session().camera;
+                          o->window, undistortion);
+    const auto& camera = overlay.compositor().output_camera();
     const double fps = overlay.replay().reader().session().value("video", nlohmann::json::object()).value("fps", 30.0);
     std::optional<VideoOutput> video;
     std::optional<FramesOutput> frames;

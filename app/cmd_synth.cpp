@@ -1,9 +1,13 @@
 // lumar synth: a synthetic recording with ground truth, for regression.
+#include <cstdio>
 #include <memory>
 
 #include "commands.h"
 #include "lumar/calib/camera_file.h"
+#include "lumar/core/error.h"
+#include "synthetic_board.h"
 #include "synthetic_recording.h"
+#include "synthetic_sweep.h"
 
 namespace lumar::app {
 
@@ -11,7 +15,7 @@ void register_synth(CLI::App& app) {
   auto s = std::make_shared<SynthSettings>();
   auto camera_file = std::make_shared<std::string>();
   auto* cmd = app.add_subcommand("synth", "Render a synthetic recording (video + tracker stream + true poses) of a scene");
-  cmd->add_option("--scene", s->scene, "Scene manifest (scene.json)")->required();
+  cmd->add_option("--scene", s->scene, "Scene manifest (scene.json); not with --board");
   cmd->add_option("--camera", *camera_file, "Camera calibration (OpenCV YAML) with lens distortion")->required();
   cmd->add_option("--out", s->out, "Recording directory to create (must not exist)")->required();
   cmd->add_option("--frames", s->frames, "Number of video frames")->capture_default_str();
@@ -35,7 +39,39 @@ void register_synth(CLI::App& app) {
       ->check(CLI::IsMember({"mjpeg", "ffv1"}))->capture_default_str();
   cmd->add_option("--quality", s->quality, "MJPEG quality")->check(CLI::Range(50, 100))->capture_default_str();
   cmd->add_option("--seed", s->seed, "Random seed for noise")->capture_default_str();
-  add_action(cmd, [s, camera_file] {
+  // --board: the tracked camera filming a checkerboard, for `lumar calibrate-rig`.
+  auto b = std::make_shared<BoardSynthSettings>();
+  auto board = std::make_shared<std::string>();
+  cmd->add_option("--board", *board, "Render a checkerboard recording instead: inner corners WxH, e.g. 9x6");
+  cmd->add_option("--square", b->square, "--board: square size in metres")->capture_default_str();
+  cmd->add_option("--seconds", b->seconds, "--board: length of the video in seconds")->capture_default_str();
+  cmd->add_option("--assumed-latency-ms", b->assumed_latency_ms,
+                  "--board: the tracker latency session.json claims (the device's is --latency-ms)")
+      ->capture_default_str();
+  cmd->add_option("--image-noise", b->image_noise, "--board: image noise, 8-bit levels RMS")->capture_default_str();
+  add_sweep_options(cmd);  // --sweep: synthetic_sweep.h
+  add_action(cmd, [cmd, s, camera_file, b, board] {
+    if (run_sweep_if_requested(cmd, *camera_file, *s)) return;
+    if (!board->empty()) {
+      int w = 0, h = 0;
+      char x = 0, extra = 0;
+      if (std::sscanf(board->c_str(), "%d%c%d%c", &w, &x, &h, &extra) != 3 || (x != 'x' && x != 'X') || w < 2 || h < 2)
+        throw InputError("--board " + *board + ": expected inner corners as WxH, e.g. 9x6");
+      b->board = {w, h};
+      b->out = s->out;
+      b->camera = calib::load_camera_file(*camera_file).intrinsics;
+      // Shared options keep the board's own defaults unless given.
+      auto given = [cmd](const char* name) { return cmd->get_option(name)->count() > 0; };
+      if (given("--fps")) b->fps = s->fps;
+      if (given("--tracker-noise-deg")) b->tracker_noise_deg = s->tracker_noise_deg;
+      if (given("--position-noise-m")) b->position_noise_m = s->position_noise_m;
+      if (given("--latency-ms")) b->latency_ms = s->latency_ms;
+      if (given("--codec")) b->codec = s->codec;
+      b->seed = s->seed;
+      synthesize_board_recording(*b);
+      return;
+    }
+    if (s->scene.empty()) throw InputError("synth: give --scene (or --board for a checkerboard recording)");
     s->camera = calib::load_camera_file(*camera_file).intrinsics;
     synthesize_recording(*s);
   });

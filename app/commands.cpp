@@ -18,8 +18,14 @@ void register_commands(CLI::App& app) {
   register_overlay(app);
   register_regress(app);
   register_calibrate(app);
+  register_calibrate_rig(app);
+  register_radiometry(app);
   register_tracker(app);
   register_devices(app);
+  register_record(app);
+  register_envmap(app);
+  register_shadows(app);
+  register_irradiance(app);
 }
 
 void run_selected(CLI::App& app) {

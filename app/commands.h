@@ -16,6 +16,10 @@ void register_synth(CLI::App& app);
 void register_overlay(CLI::App& app);
 void register_regress(CLI::App& app);
 void register_calibrate(CLI::App& app);
+// `lumar calibrate-rig`: tracker-to-camera offset and latency from a board recording.
+void register_calibrate_rig(CLI::App& app);
+// `lumar calibrate-response` and `lumar calibrate-vignetting`.
+void register_radiometry(CLI::App& app);
 // `lumar tracker ...`: the parent command; its subcommands register themselves on it.
 void register_tracker(CLI::App& app);
 void register_tracker_decode(CLI::App& tracker);
@@ -23,5 +27,13 @@ void register_tracker_emulate(CLI::App& tracker);
 void register_tracker_record(CLI::App& tracker);
 // `lumar devices`: serial ports, Polhemus USB devices and USB-serial adapters.
 void register_devices(CLI::App& app);
+// `lumar record`: frames from any source plus a tracker into a recording.
+void register_record(CLI::App& app);
+// `lumar envmap`: stitch an HDR environment map from a tracked sweep.
+void register_envmap(CLI::App& app);
+// `lumar shadows`: shadow attenuation of query points by the scene's objects.
+void register_shadows(CLI::App& app);
+// `lumar irradiance`: irradiance at query points (volume, SH9, reference, ...).
+void register_irradiance(CLI::App& app);
 
 }  // namespace lumar::app

@@ -3,6 +3,7 @@
 #include <chrono>
 #include <fmt/format.h>
 
+#include "lumar/calib/camera_response.h"
 #include "lumar/calib/undistortion.h"
 #include "lumar/core/error.h"
 
@@ -12,10 +13,25 @@ namespace {
 double ms_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 }
+
+// The session's response ("srgb" or a response JSON, relative to the recording) and vignetting.
+gl::VideoRadiometry video_radiometry(const capture::Radiometry& radiometry, const CameraIntrinsics& camera,
+                                     const std::filesystem::path& recording) {
+  gl::VideoRadiometry out;
+  out.video_camera = camera;
+  out.vignetting_a = radiometry.vignetting_a;
+  out.vignetting_b = radiometry.vignetting_b;
+  if (radiometry.response != "srgb") {
+    const std::filesystem::path file = recording / radiometry.response;  // absolute paths stay absolute
+    const calib::CameraResponse response = calib::load_camera_response(file);
+    out.linear_of_code.assign(response.exposure.begin(), response.exposure.end());
+  }
+  return out;
+}
 }  // namespace
 
 ReplayOverlay::ReplayOverlay(const std::filesystem::path& recording, const std::filesystem::path& scene_override,
-                             PoseSource poses, bool window)
+                             PoseSource poses, bool window, calib::UndistortedCamera undistortion)
     : replay_(recording), pose_source_(poses) {
   const std::filesystem::path scene_path = scene_override.empty() ? replay_.scene_path() : scene_override;
   if (scene_path.empty())
@@ -32,8 +48,9 @@ ReplayOverlay::ReplayOverlay(const std::filesystem::path& recording, const std::
   } else {
     context_ = gl::create_headless_context();
   }
-  const calib::UndistortionMaps maps = calib::make_undistortion_maps(camera);
+  const calib::UndistortionMaps maps = calib::make_undistortion_maps(camera, undistortion);
   compositor_ = std::make_unique<Compositor>(scene_, maps.output, maps.map_x, maps.map_y);
+  compositor_->renderer().set_video_radiometry(video_radiometry(replay_.session().radiometry, camera, recording));
 }
 
 ReplayOverlay::~ReplayOverlay() {

@@ -6,6 +6,7 @@
 #include <memory>
 #include <optional>
 
+#include "lumar/calib/undistortion.h"
 #include "lumar/capture/recording_replay.h"
 #include "lumar/core/compositor.h"
 #include "lumar/core/gl/context.h"
@@ -31,8 +32,10 @@ struct OverlayFrame {
 class ReplayOverlay {
  public:
   // `window`: a GLFW window to draw into; otherwise a headless EGL context is made.
+  // `undistortion`: which undistorted camera the output uses (calib/undistortion.h).
   ReplayOverlay(const std::filesystem::path& recording, const std::filesystem::path& scene_override,
-                PoseSource poses, bool window);
+                PoseSource poses, bool window,
+                calib::UndistortedCamera undistortion = calib::UndistortedCamera::SameMatrix);
   ~ReplayOverlay();
 
   // Runs every frame (up to max_frames, 0 = all) through the compositor; `sink` sees each

@@ -5,6 +5,7 @@
 #include <opencv2/imgproc.hpp>
 #include <spdlog/spdlog.h>
 
+#include "lumar/calib/envmap_view.h"
 #include "lumar/calib/undistortion.h"
 #include "lumar/capture/recording_writer.h"
 #include "lumar/capture/session.h"
@@ -22,9 +23,6 @@
 
 namespace lumar::app {
 
-namespace {
-
-// OpenCV camera axes looking from `eye` at `target`, world +Y up.
 Pose look_at(const glm::dvec3& eye, const glm::dvec3& target) {
   const glm::dvec3 forward = glm::normalize(target - eye);
   const glm::dvec3 right = glm::normalize(glm::cross(forward, glm::dvec3(0, 1, 0)));
@@ -34,6 +32,23 @@ Pose look_at(const glm::dvec3& eye, const glm::dvec3& target) {
   p.translation = eye;
   return p;
 }
+
+void write_tracker_stream(capture::RecordingWriter& writer, const tracking::SimulatedTrackerOutput& tracker,
+                          const capture::TrackerSettings& settings, Nanos assumed_latency) {
+  tracking::OutputFormat format;
+  format.output_list = settings.output_list;
+  tracking::AsciiRecordParser parser(format, 2, settings.baud);
+  for (const auto& chunk : tracker.chunks) {
+    writer.add_tracker_bytes(chunk);
+    parser.push(chunk);
+    for (const auto& r : parser.take_all()) {
+      const Nanos t = tracking::measurement_time(r.first_byte_arrival, settings.baud, assumed_latency);
+      if (auto sample = tracking::to_pose_sample(r.record, format, t)) writer.add_pose(*sample);
+    }
+  }
+}
+
+namespace {
 
 // A pinhole camera, `supersample` times finer than `camera`, wide enough to cover
 // every ray of the distorted camera (barrel distortion sees past the pinhole frame).
@@ -68,23 +83,12 @@ CameraIntrinsics covering_pinhole(const CameraIntrinsics& camera, int supersampl
 // Radiance (linear, scene units) to an 8-bit frame as the camera would record it.
 cv::Mat expose(const cv::Mat& radiance_bgr, const CameraIntrinsics& camera, const SynthSettings& s,
                double exposure, cv::RNG& rng) {
-  const double half_diagonal = 0.5 * std::hypot(camera.width, camera.height);
-  cv::Mat out(radiance_bgr.size(), CV_8UC3);
-  for (int y = 0; y < out.rows; ++y) {
-    const cv::Vec3f* in = radiance_bgr.ptr<cv::Vec3f>(y);
-    cv::Vec3b* o = out.ptr<cv::Vec3b>(y);
-    for (int x = 0; x < out.cols; ++x) {
-      const double r2 = (std::pow(x - camera.cx, 2) + std::pow(y - camera.cy, 2)) / (half_diagonal * half_diagonal);
-      const double gain = exposure * (1.0 + s.vignetting_a * r2 + s.vignetting_b * r2 * r2);
-      for (int c = 0; c < 3; ++c) {
-        const double signal = std::max(0.0, double(in[x][c]) * gain);
-        const double sigma = std::sqrt(s.shot_noise_gain * std::min(signal, 1.0) + s.read_noise * s.read_noise);
-        const double v = signal + rng.gaussian(sigma);
-        o[x][c] = cv::saturate_cast<uchar>(std::lround(linear_to_srgb(float(v)) * 255.0f));
-      }
-    }
-  }
-  return out;
+  calib::SensorModel sensor;
+  sensor.read_noise = s.read_noise;
+  sensor.shot_noise_gain = s.shot_noise_gain;
+  sensor.vignetting_a = s.vignetting_a;
+  sensor.vignetting_b = s.vignetting_b;
+  return calib::expose_8bit(radiance_bgr, camera, sensor, exposure, rng);
 }
 
 // Where the camera looks: the foot of the first virtual object (the centre of its
@@ -185,18 +189,7 @@ void synthesize_recording(const SynthSettings& s) {
   rs.size = cv::Size(s.camera.width, s.camera.height);
   try {
     capture::RecordingWriter writer(s.out, capture::session_to_json(session), rs);
-    // The tracker's bytes as they arrived, and the poses the real parser decodes from them.
-    tracking::OutputFormat format;
-    format.output_list = session.tracker.output_list;
-    tracking::AsciiRecordParser parser(format, 2, ts.baud);
-    for (const auto& chunk : tracker.chunks) {
-      writer.add_tracker_bytes(chunk);
-      parser.push(chunk);
-      for (const auto& r : parser.take_all()) {
-        const Nanos t = tracking::measurement_time(r.first_byte_arrival, ts.baud, session.rig.latency);
-        if (auto sample = tracking::to_pose_sample(r.record, format, t)) writer.add_pose(*sample);
-      }
-    }
+    write_tracker_stream(writer, tracker, session.tracker, session.rig.latency);
     cv::RNG rng(s.seed);
     for (int k = 0; k < s.frames; ++k) {
       const Nanos t = start + frame_period * k;

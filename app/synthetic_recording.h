@@ -7,8 +7,11 @@
 #include <filesystem>
 #include <string>
 
+#include "lumar/capture/recording_writer.h"
+#include "lumar/capture/session.h"
 #include "lumar/core/camera.h"
 #include "lumar/core/pose.h"
+#include "lumar/tracking/simulated_tracker.h"
 
 namespace lumar::app {
 
@@ -31,6 +34,15 @@ struct SynthSettings {
   int quality = 95;
   std::uint64_t seed = 1;
 };
+
+// OpenCV camera axes (x right, y down, z forward) looking from `eye` at `target`, world +Y up.
+Pose look_at(const glm::dvec3& eye, const glm::dvec3& target);
+
+// The tracker's bytes as they arrived (into tracker.raw), and the poses the real ASCII
+// parser decodes from them (into poses.csv), timestamped with `assumed_latency`: the
+// latency the recorder believed in, which need not be the simulated device's.
+void write_tracker_stream(capture::RecordingWriter& writer, const tracking::SimulatedTrackerOutput& tracker,
+                          const capture::TrackerSettings& settings, Nanos assumed_latency);
 
 // The camera's true pose at s in [0, 1] along the orbit around `target`.
 Pose orbit_camera_pose(const glm::dvec3& target, double s, double arc_deg);

@@ -6,6 +6,7 @@ set -euo pipefail
 packages=(
   build-essential cmake ninja-build pkg-config
   libopencv-dev                      # calibration, video I/O, image processing
+  libopencv-contrib-dev              # ChArUco boards (aruco)
   libembree-dev                      # ray queries (Embree 3)
   libopenimageio-dev                 # EXR / HDR environment maps
   libglfw3-dev libglm-dev libepoxy-dev libegl-dev libegl1-mesa-dev libx11-dev

@@ -5,6 +5,8 @@
 #include <atomic>
 #include <chrono>
 #include <condition_variable>
+#include <cstdio>
+#include <cstring>
 #include <exception>
 #include <mutex>
 #include <opencv2/videoio.hpp>
@@ -38,6 +40,21 @@ void append_pose_fields(std::string& out, const Pose& p) {
     out.push_back(',');
     csv::append_double(out, v);
   }
+}
+
+// OpenCV's video writer does not report failed writes (a full disk, a file size
+// limit): it leaves a short file. Its AVI header, patched at release() near the start
+// of the file, still gives the size the file should have; a shorter file is torn.
+void check_avi_complete(const fs::path& file, std::uintmax_t size) {
+  std::FILE* f = std::fopen(file.c_str(), "rb");
+  unsigned char h[8] = {};
+  const bool read = f && std::fread(h, 1, 8, f) == 8;
+  if (f) std::fclose(f);
+  const std::uint64_t riff = std::uint64_t(h[4]) | std::uint64_t(h[5]) << 8 | std::uint64_t(h[6]) << 16 |
+                             std::uint64_t(h[7]) << 24;
+  if (!read || std::memcmp(h, "RIFF", 4) != 0 || riff == 0 || riff + 8 > size)
+    throw RuntimeError(file.string() + ": the video segment was cut short (" + std::to_string(size) +
+                       " bytes written); the disk is full or a file size limit was hit");
 }
 
 // The directory that holds `dir`'s entry, for fsync after creating `dir`.
@@ -154,8 +171,10 @@ struct RecordingWriter::Impl {
     const fs::path partial = partial_segment_path(dir, settings.codec, segment_number);
     const fs::path final_path = segment_path(dir, settings.codec, segment_number);
     std::error_code ec;
-    if (fs::file_size(partial, ec) == 0 || ec)
+    const auto size = fs::file_size(partial, ec);
+    if (size == 0 || ec)
       throw RuntimeError(partial.string() + ": the video writer left no data; check free space");
+    if (settings.codec == "mjpeg") check_avi_complete(partial, size);
     fsync_path(partial);
     fs::rename(partial, final_path, ec);
     if (ec)

@@ -3,7 +3,11 @@
 #include <spdlog/spdlog.h>
 
 #include "lumar/core/envmap.h"
+#include "lumar/core/irradiance_scene.h"
+#include "lumar/core/irradiance_volume.h"
 #include "lumar/core/mesh.h"
+#include "lumar/core/shadow_methods.h"
+#include "lumar/core/shadow_occlusion.h"
 
 namespace lumar {
 
@@ -16,9 +20,24 @@ Compositor::Compositor(const Scene& scene, const CameraIntrinsics& output_camera
   sh_ = project_radiance_sh9(map);
 
   renderer_ = std::make_unique<gl::Renderer>(camera_);
+  Mesh room;
   if (!scene.room_mesh.empty()) {
     const double s = scene.room_scale;
-    renderer_->set_room(transformed(load_mesh(scene.room_mesh), glm::dmat4(glm::dmat3(s))));
+    room = transformed(load_mesh(scene.room_mesh), glm::dmat4(glm::dmat3(s)));
+    renderer_->set_room(room);
+  }
+  // Spatially varying light: the irradiance volume over the movement box (cached on disk).
+  if (const std::string method = scene_lighting_method(scene); method != "sh9") {
+    const VolumeSettings settings = scene_volume_settings(scene, method);
+    const bool distant = scene.distant_map || room.triangle_count() == 0;
+    const auto radiance = distant ? std::make_unique<RoomRadiance>(map, settings.radiance)
+                                  : std::make_unique<RoomRadiance>(map, room, settings.radiance);
+    bool loaded = false;
+    volume_ = std::make_shared<IrradianceVolume>(
+        cached_irradiance_volume(*radiance, scene.movement_min, scene.movement_max, settings, {}, &loaded));
+    renderer_->set_irradiance_volume(volume_.get());
+    spdlog::debug("irradiance volume ({}): {} probes, {}", settings.describe(), volume_->stats().probes,
+                  loaded ? "loaded from the cache" : "built");
   }
   renderer_->set_environment(map);
   if (!map_x.empty()) renderer_->set_undistortion_map(map_x, map_y);
@@ -34,10 +53,45 @@ Compositor::Compositor(const Scene& scene, const CameraIntrinsics& output_camera
       object_points_.push_back(glm::dvec3(object.T_world_model * glm::dvec4(glm::dvec3(mesh.positions[i]), 1.0)));
     spdlog::debug("object '{}': {} triangles", object.name, mesh.triangle_count());
   }
+  build_shadows(scene);
+}
+
+// Precomputes the shadow lines from the scene's receivers to its emitters; the objects
+// are the occluders.
+void Compositor::build_shadows(const Scene& scene) {
+  const ShadowScene shadow_scene(scene);
+  const Mesh receivers = shadow_scene.receivers();
+  if (receivers.triangle_count() == 0 || shadow_scene.objects().empty()) return;
+  const Emitters emitters = shadow_scene.emitters(receivers.positions, receivers.normals);
+  shadows_ = std::make_shared<LineShadows>(
+      build_shadow_lines(receivers.positions, receivers.normals, emitters, shadow_scene.proxy()));
+  for (const auto& o : shadow_scene.objects()) shadows_->add_object(o.model, o.T_world_model);
+  renderer_->set_receivers(receivers);
+  spdlog::debug("shadows: {} receivers, {} emitter patches, {} lines", receivers.positions.size(),
+                emitters.patches.size(), shadows_->lines().lines.size());
+}
+
+void Compositor::set_object_pose(std::size_t index, const glm::dmat4& T_world_model) {
+  renderer_->set_object_pose(int(index), T_world_model);
+  if (shadows_) shadows_->set_object_pose(int(index), T_world_model);
+}
+
+void Compositor::set_shadows_enabled(bool on) {
+  if (on == shadows_enabled_) return;
+  shadows_enabled_ = on;
+  shadows_uploaded_ = false;
+  if (shadows_ && !on) {
+    const std::vector<glm::vec3> ones(shadows_->attenuation().size(), glm::vec3(1.0f));
+    renderer_->set_receiver_attenuation(ones);
+  }
 }
 
 cv::Mat Compositor::composite(const cv::Mat& video_bgr8, const std::optional<Pose>& T_world_camera, double exposure,
                               gl::OverlayTimings* timings) {
+  if (shadows_ && shadows_enabled_ && (shadows_->update() || !shadows_uploaded_)) {
+    renderer_->set_receiver_attenuation(shadows_->attenuation());
+    shadows_uploaded_ = true;
+  }
   return renderer_->render_overlay(video_bgr8, T_world_camera, exposure, timings);
 }
 

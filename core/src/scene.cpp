@@ -157,13 +157,51 @@ SceneObject read_object(const ManifestReader& r, const json& v, const std::strin
   return object;
 }
 
+std::vector<SceneBox> read_boxes(const ManifestReader& r, const json& parent, const std::string& parent_key,
+                                 const char* name) {
+  std::vector<SceneBox> boxes;
+  if (!parent.contains(name)) return boxes;
+  const std::string key = ManifestReader::join(parent_key, name);
+  const json& list = parent.at(name);
+  if (!list.is_array()) r.fail(key, "expected an array of {\"min\": [x, y, z], \"max\": [x, y, z]} boxes");
+  for (std::size_t i = 0; i < list.size(); ++i) {
+    const std::string k = key + "[" + std::to_string(i) + "]";
+    if (!list[i].is_object()) r.fail(k, "expected an object with min and max");
+    r.only_keys(list[i], k, {"min", "max"});
+    if (!list[i].contains("min")) r.fail(k + ".min", "missing");
+    if (!list[i].contains("max")) r.fail(k + ".max", "missing");
+    SceneBox b{r.vec3(list[i].at("min"), k + ".min"), r.vec3(list[i].at("max"), k + ".max")};
+    for (int a = 0; a < 3; ++a)
+      if (b.min[a] > b.max[a]) r.fail(k, "min must not exceed max on any axis");
+    boxes.push_back(b);
+  }
+  return boxes;
+}
+
+ShadowRegions read_shadows(const ManifestReader& r, const json& doc) {
+  ShadowRegions out;
+  if (!doc.contains("shadows")) return out;
+  const json& v = r.object(doc, "", "shadows");
+  r.only_keys(v, "shadows", {"receivers", "emitters", "receiver_vertices"});
+  out.receivers = read_boxes(r, v, "shadows", "receivers");
+  out.emitters = read_boxes(r, v, "shadows", "emitters");
+  if (v.contains("receiver_vertices")) {
+    const json& n = v.at("receiver_vertices");
+    if (!n.is_number_integer() || n.get<long long>() < 4 || n.get<long long>() > 1000000)
+      r.fail("shadows.receiver_vertices", "expected an integer from 4 to 1000000");
+    out.receiver_vertices = int(n.get<long long>());
+  }
+  return out;
+}
+
 }  // namespace
 
 Scene load_scene(const std::filesystem::path& manifest) {
   const json doc = parse_manifest(manifest);
   const ManifestReader r(manifest);
   if (!doc.is_object()) r.fail("(top level)", "expected a JSON object");
-  r.only_keys(doc, "", {"format", "version", "room", "environment_map", "movement_box", "objects", "lighting"});
+  r.only_keys(doc, "", {"format", "version", "room", "environment_map", "movement_box", "objects", "lighting",
+                      "shadows"});
 
   if (!doc.contains("format") || doc.at("format") != "lumar-scene")
     r.fail("format", "expected \"lumar-scene\"");
@@ -223,6 +261,7 @@ Scene load_scene(const std::filesystem::path& manifest) {
     if (!doc.at("lighting").is_object()) r.fail("lighting", "expected an object");
     scene.lighting = doc.at("lighting");
   }
+  scene.shadows = read_shadows(r, doc);
   return scene;
 }
 

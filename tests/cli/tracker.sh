@@ -43,6 +43,10 @@ case_devices_lists_or_says_none() {
   grep -q "^Serial ports:" "$TMP/out" || fail "no serial port section"
   grep -q "^Polhemus USB devices" "$TMP/out" || fail "no Polhemus section"
   grep -q "^USB-serial adapters" "$TMP/out" || fail "no USB-serial section"
+  grep -q "^V4L2 cameras:" "$TMP/out" || fail "no V4L2 camera section"
+  if ! ls /dev/video* >/dev/null 2>&1; then
+    grep -q "none (no /dev/video\*)" "$TMP/out" || fail "no camera here, but the list does not say none"
+  fi
   if ! grep -q "^  [0-9a-f]\{4\}:[0-9a-f]\{4\}" "$TMP/out"; then
     grep -q "No tracker hardware found" "$TMP/out" || fail "no USB device listed and no plain 'none found'"
   fi

@@ -1,6 +1,8 @@
 #include "lumar/core/gl/renderer.h"
 
+#include <algorithm>
 #include <array>
+#include <cmath>
 #include <chrono>
 #include <glm/gtc/matrix_transform.hpp>
 #include <glm/gtc/type_ptr.hpp>
@@ -9,7 +11,9 @@
 
 #include "gl/gl_util.h"
 #include "gl/gpu_mesh.h"
+#include "gl/irradiance_textures.h"
 #include "gl/shaders.h"
+#include "gl/shadow_pass.h"
 #include "lumar/core/error.h"
 
 namespace lumar::gl {
@@ -95,12 +99,19 @@ struct Renderer::Impl {
   GlName empty_vertex_array;  // core profile needs one bound even for attribute-less draws
   GlName background, depth_only, shaded_object, world_position, room_radiance, encode;
   GpuMesh room;
+  std::unique_ptr<ShadowPass> receivers;  // shadow receivers, drawn over the video
   std::vector<Object> objects;
 
   GlName video;
   int video_width = 0, video_height = 0;
   GlName undistortion_map;
 
+  GlName response_decode, response_encode;  // empty: sRGB
+  glm::vec3 response_max{1.0f};
+  glm::vec2 vignetting{0.0f};
+  CameraIntrinsics video_camera;  // the distorted camera the vignetting is defined on
+
+  std::unique_ptr<IrradianceTextures> volume;  // shades objects when set
   GlName environment;
   glm::vec3 capture_position{0.0f};
   glm::mat3 map_from_world{1.0f};
@@ -142,6 +153,8 @@ struct Renderer::Impl {
   void draw_objects(GLuint program, const glm::mat4& vp, bool shaded, float exposure) {
     glUseProgram(program);
     if (shaded) glProgramUniform1f(program, uniform(program, "exposure"), exposure);
+    if (shaded) glProgramUniform1i(program, uniform(program, "use_volume"), volume ? 1 : 0);
+    if (shaded && volume) volume->bind(program);
     for (const Object& o : objects) {
       set_transform(program, o.model, o.normal_matrix, vp);
       if (shaded) {
@@ -198,7 +211,8 @@ Renderer::Renderer(const CameraIntrinsics& camera) : impl_(std::make_unique<Impl
   using namespace shaders;
   r.background = create_program("background", kFullscreenVertex, kBackgroundFragment);
   r.depth_only = create_program("proxy depth", kMeshVertex, kDepthOnlyFragment);
-  r.shaded_object = create_program("shaded object", kMeshVertex, kShadedObjectFragment);
+  r.shaded_object = create_program("shaded object", kMeshVertex,
+                                   (std::string(kShadedObjectFragment) + kIrradianceVolumeGlsl).c_str());
   r.world_position = create_program("world position", kMeshVertex, kWorldPositionFragment);
   r.room_radiance = create_program("room radiance", kMeshVertex, kRoomRadianceFragment);
   r.encode = create_program("sRGB encode", kFullscreenVertex, kEncodeFragment);
@@ -212,6 +226,21 @@ Renderer::~Renderer() = default;
 void Renderer::set_room(const Mesh& room_world) {
   impl_->room = GpuMesh(room_world, "proxy room mesh");
   check_gl_errors("Renderer::set_room");
+}
+
+void Renderer::set_receivers(const Mesh& receivers_world) {
+  if (receivers_world.indices.empty()) {
+    impl_->receivers.reset();
+    return;
+  }
+  if (!impl_->receivers) impl_->receivers = std::make_unique<ShadowPass>();
+  impl_->receivers->set_receivers(receivers_world);
+}
+
+void Renderer::set_receiver_attenuation(std::span<const glm::vec3> attenuation) {
+  if (!impl_->receivers)
+    throw InputError("Renderer::set_receiver_attenuation: no receivers; call set_receivers first");
+  impl_->receivers->set_attenuation(attenuation);
 }
 
 void Renderer::set_environment(const EnvironmentMap& map) {
@@ -254,6 +283,11 @@ void Renderer::set_object_material(int id, const glm::vec3& albedo, const SH9& i
   for (int i = 0; i < 9; ++i) o.sh[std::size_t(i)] = glm::vec3(irradiance_sh.coefficients[std::size_t(i)]);
 }
 
+void Renderer::set_irradiance_volume(const IrradianceVolume* volume) {
+  impl_->volume = volume ? std::make_unique<IrradianceTextures>(*volume) : nullptr;
+  check_gl_errors("Renderer::set_irradiance_volume");
+}
+
 void Renderer::set_undistortion_map(const cv::Mat& map_x, const cv::Mat& map_y) {
   Impl& r = *impl_;
   const cv::Size size(r.camera.width, r.camera.height);
@@ -269,6 +303,53 @@ void Renderer::set_undistortion_map(const cv::Mat& map_x, const cv::Mat& map_y) 
   glPixelStorei(GL_UNPACK_ROW_LENGTH, 0);
   glTextureSubImage2D(r.undistortion_map.get(), 0, 0, 0, size.width, size.height, GL_RG, GL_FLOAT, xy.data);
   check_gl_errors("Renderer::set_undistortion_map");
+}
+
+void Renderer::set_video_radiometry(const VideoRadiometry& radiometry) {
+  Impl& r = *impl_;
+  if (!std::isfinite(radiometry.vignetting_a) || !std::isfinite(radiometry.vignetting_b))
+    throw InputError("Renderer::set_video_radiometry: vignetting coefficients must be finite");
+  r.vignetting = glm::vec2(float(radiometry.vignetting_a), float(radiometry.vignetting_b));
+  r.video_camera = radiometry.video_camera;
+  if (radiometry.linear_of_code.empty()) {
+    r.response_decode = GlName();
+    r.response_encode = GlName();
+    return;
+  }
+  const auto& table = radiometry.linear_of_code;
+  if (table.size() != 3)
+    throw InputError("Renderer::set_video_radiometry: the response needs 3 channels, got " +
+                     std::to_string(table.size()));
+  for (const auto& channel : table)
+    for (int code = 0; code < 256; ++code)
+      if (!std::isfinite(channel[std::size_t(code)]) || channel[std::size_t(code)] < 0.0f ||
+          (code > 0 && channel[std::size_t(code)] < channel[std::size_t(code - 1)]))
+        throw InputError("Renderer::set_video_radiometry: the response is not finite, non-negative and "
+                         "non-decreasing at code " + std::to_string(code) + "; recalibrate it");
+  // Decode: the table itself, RGB order. Encode: its inverse sampled at linear = s^2 * max,
+  // dense near black where codes are closest together in linear terms.
+  constexpr int kEncodeSize = 4096;
+  std::vector<float> decode(256 * 3), encode(kEncodeSize * 3);
+  for (int c = 0; c < 3; ++c) {
+    const auto& lut = table[std::size_t(2 - c)];  // BGR -> RGB
+    r.response_max[c] = std::max(lut[255], 1e-12f);
+    for (int code = 0; code < 256; ++code) decode[std::size_t(code * 3 + c)] = lut[std::size_t(code)];
+    int code = 0;
+    for (int i = 0; i < kEncodeSize; ++i) {
+      const float s = float(i) / float(kEncodeSize - 1), linear = s * s * r.response_max[c];
+      while (code < 254 && lut[std::size_t(code + 1)] < linear) ++code;
+      const float lo = lut[std::size_t(code)], hi = lut[std::size_t(code + 1)];
+      const float f = hi > lo ? std::clamp((linear - lo) / (hi - lo), 0.0f, 1.0f) : (linear >= hi ? 1.0f : 0.0f);
+      encode[std::size_t(i * 3 + c)] = (float(code) + f) / 255.0f;
+    }
+  }
+  r.response_decode = create_texture_2d(GL_RGB32F, 256, 1, GL_LINEAR, GL_CLAMP_TO_EDGE, GL_CLAMP_TO_EDGE);
+  r.response_encode = create_texture_2d(GL_RGB32F, kEncodeSize, 1, GL_LINEAR, GL_CLAMP_TO_EDGE, GL_CLAMP_TO_EDGE);
+  glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+  glPixelStorei(GL_UNPACK_ROW_LENGTH, 0);
+  glTextureSubImage2D(r.response_decode.get(), 0, 0, 0, 256, 1, GL_RGB, GL_FLOAT, decode.data());
+  glTextureSubImage2D(r.response_encode.get(), 0, 0, 0, kEncodeSize, 1, GL_RGB, GL_FLOAT, encode.data());
+  check_gl_errors("Renderer::set_video_radiometry");
 }
 
 cv::Mat Renderer::render_overlay(const cv::Mat& video_bgr8, const std::optional<Pose>& T_world_camera,
@@ -292,6 +373,8 @@ cv::Mat Renderer::render_overlay(const cv::Mat& video_bgr8, const std::optional<
   glProgramUniform2f(bg, uniform(bg, "output_size"), float(r.camera.width), float(r.camera.height));
   glBindTextureUnit(shaders::kVideoUnit, r.video.get());
   glBindTextureUnit(shaders::kUndistortionMapUnit, r.undistortion_map.get());
+  glProgramUniform1i(bg, uniform(bg, "use_response_lut"), r.response_decode ? 1 : 0);
+  glBindTextureUnit(shaders::kResponseDecodeUnit, r.response_decode.get());
   r.draw_fullscreen();
   clock.mark(&t.background_ms);
 
@@ -302,6 +385,7 @@ cv::Mat Renderer::render_overlay(const cv::Mat& video_bgr8, const std::optional<
     glDepthFunc(GL_LESS);
     glDepthMask(GL_TRUE);
     r.draw_room_depth(vp);
+    if (r.receivers) r.receivers->draw(vp);  // shadows on the video, before the objects
     clock.mark(&t.depth_ms);
 
     r.draw_objects(r.shaded_object.get(), vp, true, float(exposure));
@@ -311,8 +395,20 @@ cv::Mat Renderer::render_overlay(const cv::Mat& video_bgr8, const std::optional<
 
   // Encode to sRGB 8-bit (rows flipped) and read back top row first.
   r.encoded.begin();
-  glUseProgram(r.encode.get());
+  const GLuint enc = r.encode.get();
+  glUseProgram(enc);
+  glProgramUniform1i(enc, uniform(enc, "use_response_lut"), r.response_encode ? 1 : 0);
+  glProgramUniform3fv(enc, uniform(enc, "lut_max"), 1, glm::value_ptr(r.response_max));
+  // Without an undistortion map the video is the output camera's image.
+  const bool mapped = bool(r.undistortion_map) && r.video_camera.is_valid();
+  const CameraIntrinsics& vc = mapped ? r.video_camera : r.camera;
+  glProgramUniform1i(enc, uniform(enc, "use_undistortion_map"), mapped ? 1 : 0);
+  glProgramUniform2f(enc, uniform(enc, "principal_point"), float(vc.cx), float(vc.cy));
+  glProgramUniform1f(enc, uniform(enc, "half_diagonal"), 0.5f * std::hypot(float(vc.width), float(vc.height)));
+  glBindTextureUnit(shaders::kUndistortionMapUnit, r.undistortion_map.get());
+  glProgramUniform2fv(enc, uniform(enc, "vignetting"), 1, glm::value_ptr(r.vignetting));
   glBindTextureUnit(shaders::kLinearImageUnit, r.scene.color.get());
+  glBindTextureUnit(shaders::kResponseEncodeUnit, r.response_encode.get());
   r.draw_fullscreen();
   cv::Mat out(r.camera.height, r.camera.width, CV_8UC3);
   glPixelStorei(GL_PACK_ALIGNMENT, 1);

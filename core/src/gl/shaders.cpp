@@ -32,7 +32,9 @@ const char* const kBackgroundFragment = R"glsl(
 #version 450 core
 layout(binding = 0) uniform sampler2D video;           // texel row 0 = top row of the frame
 layout(binding = 1) uniform sampler2D undistortion_map; // RG32F, output size, row 0 = top
+layout(binding = 4) uniform sampler2D response_decode;  // 256 x 1 RGB: linear value of each code
 uniform bool use_undistortion_map;
+uniform bool use_response_lut;  // false: the default sRGB response
 uniform vec2 output_size;
 out vec4 color;
 
@@ -50,8 +52,17 @@ void main() {
   } else {
     uv = vec2(gl_FragCoord.x, output_size.y - gl_FragCoord.y) / output_size;
   }
-  // Filter the encoded values, as cv::remap does, then decode.
-  color = vec4(srgb_to_linear(texture(video, uv).rgb), 1.0);
+  // Filter the encoded values, as cv::remap does, then decode. Alpha 0 marks video
+  // pixels: the encode pass vignettes only what was rendered.
+  vec3 code = texture(video, uv).rgb;
+  if (use_response_lut) {
+    // Linear interpolation between the table's entries at code * 255.
+    vec3 x = (code * 255.0 + 0.5) / 256.0;
+    color = vec4(texture(response_decode, vec2(x.r, 0.5)).r, texture(response_decode, vec2(x.g, 0.5)).g,
+                 texture(response_decode, vec2(x.b, 0.5)).b, 0.0);
+  } else {
+    color = vec4(srgb_to_linear(code), 0.0);
+  }
 }
 )glsl";
 
@@ -67,6 +78,8 @@ in vec3 world_normal;
 uniform vec3 albedo;
 uniform float exposure;
 uniform vec3 sh[9];  // L00, L1-1, L10, L11, L2-2, L2-1, L20, L21, L22 (world frame)
+uniform bool use_volume;  // irradiance volume (gl/irradiance_textures.cpp) instead of sh
+vec3 volume_irradiance(vec3 p, vec3 n);
 out vec4 color;
 
 // Ramamoorthi & Hanrahan 2001, eq. 13, with the world normal's x, y, z.
@@ -81,7 +94,7 @@ vec3 sh_irradiance(vec3 n) {
 void main() {
   vec3 n = normalize(world_normal);
   // Nine coefficients can ring below zero opposite a bright source; light is never negative.
-  vec3 irradiance = max(sh_irradiance(n), vec3(0.0));
+  vec3 irradiance = use_volume ? volume_irradiance(world_position, n) : max(sh_irradiance(n), vec3(0.0));
   color = vec4(albedo * irradiance * (exposure / 3.14159265358979), 1.0);
 }
 )glsl";
@@ -116,6 +129,14 @@ void main() {
 const char* const kEncodeFragment = R"glsl(
 #version 450 core
 layout(binding = 3) uniform sampler2D linear_image;
+layout(binding = 1) uniform sampler2D undistortion_map; // RG32F, output size, row 0 = top
+layout(binding = 5) uniform sampler2D response_encode;  // N x 1 RGB: code / 255 at linear = s^2 * lut_max
+uniform bool use_response_lut;
+uniform bool use_undistortion_map;
+uniform vec3 lut_max;            // linear value of code 255, per channel
+uniform vec2 principal_point;    // OpenCV pixels of the video's (distorted) camera
+uniform float half_diagonal;     // of the video's image, pixels
+uniform vec2 vignetting;         // (a, b): gain 1 + a r^2 + b r^4
 out vec4 color;
 
 vec3 linear_to_srgb(vec3 v) {
@@ -128,7 +149,23 @@ void main() {
   ivec2 size = textureSize(linear_image, 0);
   ivec2 p = ivec2(gl_FragCoord.xy);
   p.y = size.y - 1 - p.y;
-  color = vec4(linear_to_srgb(texelFetch(linear_image, p, 0).rgb), 1.0);
+  vec4 v = texelFetch(linear_image, p, 0);
+  // Rendered pixels (alpha 1) fall off towards the corners as the camera's own pixels
+  // did; video pixels (alpha 0) already have the camera's vignetting.
+  vec2 pixel = floor(gl_FragCoord.xy);  // the output's OpenCV pixel (its rows are flipped on read-back)
+  // Vignetting belongs to the camera's own pixels: where this one came from in the video.
+  if (use_undistortion_map) pixel = texelFetch(undistortion_map, ivec2(pixel), 0).xy;
+  float r2 = dot(pixel - principal_point, pixel - principal_point) / (half_diagonal * half_diagonal);
+  vec3 linear = v.rgb * mix(1.0, 1.0 + vignetting.x * r2 + vignetting.y * r2 * r2, v.a);
+  if (use_response_lut) {
+    vec3 s = sqrt(clamp(linear / lut_max, 0.0, 1.0));
+    float n = float(textureSize(response_encode, 0).x);
+    vec3 x = (s * (n - 1.0) + 0.5) / n;
+    color = vec4(texture(response_encode, vec2(x.r, 0.5)).r, texture(response_encode, vec2(x.g, 0.5)).g,
+                 texture(response_encode, vec2(x.b, 0.5)).b, 1.0);
+  } else {
+    color = vec4(linear_to_srgb(linear), 1.0);
+  }
 }
 )glsl";
 

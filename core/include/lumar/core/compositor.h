@@ -14,6 +14,9 @@
 
 namespace lumar {
 
+class LineShadows;
+class IrradianceVolume;
+
 class Compositor {
  public:
   // `output_camera`: the undistorted camera the renderer draws with. `map_x`, `map_y`:
@@ -27,9 +30,20 @@ class Compositor {
   cv::Mat composite(const cv::Mat& video_bgr8, const std::optional<Pose>& T_world_camera, double exposure,
                     gl::OverlayTimings* timings = nullptr);
 
+  // Moves object `index` (manifest order): the renderer and the shadow lines follow; the
+  // shadows are recomputed in the next composite() only if a pose changed.
+  void set_object_pose(std::size_t index, const glm::dmat4& T_world_model);
+  // Soft shadows of the objects on the receivers (docs/shadows.md); on by default.
+  void set_shadows_enabled(bool on);
+  // The shadow lines, or nullptr when the scene has no receivers.
+  const LineShadows* shadows() const { return shadows_.get(); }
+
   gl::Renderer& renderer() { return *renderer_; }
   const CameraIntrinsics& output_camera() const { return camera_; }
   const SH9& lighting_sh() const { return sh_; }
+  // The irradiance volume that shades the objects per pixel (built for the scene's
+  // movement box, or loaded from the cache), or nullptr when lighting.method is "sh9".
+  const IrradianceVolume* irradiance_volume() const { return volume_.get(); }
   // A few hundred surface points of the virtual objects, world coordinates, for
   // checking where they project.
   const std::vector<glm::dvec3>& object_points() const { return object_points_; }
@@ -38,7 +52,11 @@ class Compositor {
   CameraIntrinsics camera_;
   SH9 sh_;
   std::unique_ptr<gl::Renderer> renderer_;
+  std::shared_ptr<IrradianceVolume> volume_;  // shared_ptr: incomplete here
+  void build_shadows(const Scene& scene);
   std::vector<glm::dvec3> object_points_;
+  std::shared_ptr<LineShadows> shadows_;  // shared_ptr: LineShadows is incomplete here
+  bool shadows_enabled_ = true, shadows_uploaded_ = false;
 };
 
 }  // namespace lumar

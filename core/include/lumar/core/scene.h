@@ -18,6 +18,23 @@ struct SceneObject {
   glm::vec3 albedo{0.8f};
 };
 
+// An axis-aligned world box (metres) marking a region of the proxy room.
+struct SceneBox {
+  glm::dvec3 min{0.0}, max{0.0};
+  bool contains(const glm::dvec3& p) const {
+    return p.x >= min.x && p.y >= min.y && p.z >= min.z && p.x <= max.x && p.y <= max.y && p.z <= max.z;
+  }
+};
+
+// Where shadows fall and where their light comes from (manifest key "shadows",
+// docs/shadows.md). Empty lists mean the defaults: the floor under the movement box
+// receives, and every texel of the map emits.
+struct ShadowRegions {
+  std::vector<SceneBox> receivers;  // proxy surfaces inside these boxes receive shadows
+  std::vector<SceneBox> emitters;   // only map light landing on the proxy inside these boxes emits
+  int receiver_vertices = 3200;     // about this many receiver vertices, spread uniformly
+};
+
 struct Scene {
   std::filesystem::path manifest;
   std::filesystem::path room_mesh;
@@ -29,6 +46,7 @@ struct Scene {
   glm::dvec3 movement_min{0.0}, movement_max{0.0};
   std::vector<SceneObject> objects;
   nlohmann::json lighting = nlohmann::json::object();  // per-method settings, kept as given
+  ShadowRegions shadows;
 };
 
 // Throws InputError naming the manifest (and the key) on missing files, malformed

@@ -6,10 +6,13 @@
 //
 // Create, use and destroy a Renderer while the same gl::Context is current.
 // Images are OpenCV-shaped: top row first, BGR channel order.
+#include <array>
 #include <glm/glm.hpp>
 #include <memory>
 #include <optional>
+#include <span>
 #include <opencv2/core.hpp>
+#include <vector>
 
 #include "lumar/core/camera.h"
 #include "lumar/core/envmap.h"
@@ -17,12 +20,29 @@
 #include "lumar/core/pose.h"
 #include "lumar/core/sh.h"
 
+namespace lumar {
+class IrradianceVolume;
+}
+
 namespace lumar::gl {
 
 // Wall time of each stage of render_overlay. Asking for timings makes the stages wait
 // for each other (glFinish between them), so ask only when profiling.
 struct OverlayTimings {
   double upload_ms = 0, background_ms = 0, depth_ms = 0, objects_ms = 0, readback_ms = 0;
+};
+
+// How the camera turned light into video, so that rendered pixels look like the
+// camera's: its response (8-bit code -> linear value) and its radial vignetting.
+struct VideoRadiometry {
+  // linear_of_code[channel][code], channels B, G, R (OpenCV order), non-decreasing.
+  // Empty: the default sRGB curve.
+  std::vector<std::array<float, 256>> linear_of_code;
+  // Gain 1 + a r^2 + b r^4, r = distance from the principal point over the half-diagonal,
+  // in the pixels of `video_camera` (the distorted camera the undistortion map samples).
+  // Without an undistortion map or a valid video_camera: the output camera's pixels.
+  double vignetting_a = 0.0, vignetting_b = 0.0;
+  CameraIntrinsics video_camera;
 };
 
 class Renderer {
@@ -43,11 +63,25 @@ class Renderer {
   int add_object(const Mesh& mesh_model);
   void set_object_pose(int id, const glm::dmat4& T_world_model);
   void set_object_material(int id, const glm::vec3& albedo, const SH9& irradiance_sh);
+  // Shade every object per pixel from this irradiance volume (uploaded as textures;
+  // core/irradiance_volume.h) instead of its SH9; nullptr goes back to SH9.
+  void set_irradiance_volume(const IrradianceVolume* volume);
+
+  // Shadow receivers (world mesh of real surfaces): in render_overlay the video under
+  // them is multiplied by their per-vertex attenuation E_with / E_without (1 until set).
+  // An empty mesh removes them.
+  void set_receivers(const Mesh& receivers_world);
+  void set_receiver_attenuation(std::span<const glm::vec3> attenuation);
 
   // Where each output pixel samples the distorted video: cv::initUndistortRectifyMap's
   // map1/map2 as CV_32FC1, output size. Without it the video is drawn unwarped
   // (scaled to the output size).
   void set_undistortion_map(const cv::Mat& map_x, const cv::Mat& map_y);
+
+  // The video's response and vignetting (default: sRGB, no vignetting). Video pixels
+  // pass through unchanged; rendered pixels get the vignetting and the response.
+  // Throws InputError for a table that is not 3 x 256 finite non-decreasing values.
+  void set_video_radiometry(const VideoRadiometry& radiometry);
 
   // One composited frame (BGR8, output size). `video_bgr8` is the distorted video frame
   // (CV_8UC3, the undistortion map's source size); `exposure` is the video's linear

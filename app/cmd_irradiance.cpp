@@ -1,0 +1,172 @@
+// lumar irradiance: irradiance at query points (world position and normal) from a scene's
+// room and map, or from a distant map alone.
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <memory>
+#include <sstream>
+
+#include "commands.h"
+#include "lumar/core/error.h"
+#include "lumar/core/irradiance_reference.h"
+#include "lumar/core/irradiance_scene.h"
+
+namespace lumar::app {
+
+namespace {
+
+struct IrradianceOptions {
+  std::string scene, envmap, query, out, method, cache;
+  bool no_cache = false;
+  int strata = 64;
+};
+
+struct Query {
+  std::vector<glm::dvec3> points, normals;
+};
+
+Query read_queries(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw InputError(path + ": query file not found or unreadable; give a CSV with header x,y,z,nx,ny,nz");
+  std::string line;
+  if (!std::getline(in, line)) throw InputError(path + ": empty query file; expected a header x,y,z,nx,ny,nz");
+  std::vector<std::string> header;
+  {
+    std::stringstream ss(line);
+    std::string cell;
+    while (std::getline(ss, cell, ',')) {
+      cell.erase(0, cell.find_first_not_of(" \t\r"));
+      cell.erase(cell.find_last_not_of(" \t\r") + 1);
+      header.push_back(cell);
+    }
+  }
+  const char* names[6] = {"x", "y", "z", "nx", "ny", "nz"};
+  int column[6];
+  for (int k = 0; k < 6; ++k) {
+    const auto it = std::find(header.begin(), header.end(), names[k]);
+    if (it == header.end())
+      throw InputError(path + ": header has no column '" + names[k] + "'; expected x,y,z,nx,ny,nz");
+    column[k] = int(it - header.begin());
+  }
+  Query q;
+  int number = 1;
+  while (std::getline(in, line)) {
+    ++number;
+    if (line.find_first_not_of(" \t\r") == std::string::npos) continue;
+    std::vector<double> values;
+    std::stringstream ss(line);
+    std::string cell;
+    while (std::getline(ss, cell, ',')) {
+      char* end = nullptr;
+      const double v = std::strtod(cell.c_str(), &end);
+      while (end && (*end == ' ' || *end == '\t' || *end == '\r')) ++end;
+      if (cell.empty() || !end || *end != '\0' || !std::isfinite(v))
+        throw InputError(path + ": line " + std::to_string(number) + ": '" + cell + "' is not a number");
+      values.push_back(v);
+    }
+    if (values.size() != header.size())
+      throw InputError(path + ": line " + std::to_string(number) + ": expected " + std::to_string(header.size()) +
+                       " values like the header, got " + std::to_string(values.size()));
+    const glm::dvec3 p(values[column[0]], values[column[1]], values[column[2]]);
+    const glm::dvec3 n(values[column[3]], values[column[4]], values[column[5]]);
+    if (glm::length(n) < 1e-9)
+      throw InputError(path + ": line " + std::to_string(number) + ": the normal (nx, ny, nz) is zero");
+    q.points.push_back(p);
+    q.normals.push_back(glm::normalize(n));
+  }
+  return q;
+}
+
+void write_results(const std::string& path, const std::vector<glm::dvec3>& e) {
+  const std::string tmp = path + ".tmp";
+  {
+    std::ofstream out(tmp, std::ios::trunc);
+    if (!out) throw InputError(path + ": cannot write the output; check that the folder exists and is writable");
+    out << "r,g,b\n";
+    char buf[96];
+    for (const glm::dvec3& v : e) {
+      std::snprintf(buf, sizeof(buf), "%.9g,%.9g,%.9g\n", v.r, v.g, v.b);
+      out << buf;
+    }
+    out.flush();
+    if (!out) {
+      std::remove(tmp.c_str());
+      throw RuntimeError(path + ": writing the output failed (disk full?)");
+    }
+  }
+  std::error_code ec;
+  std::filesystem::rename(tmp, path, ec);
+  if (ec) {
+    std::remove(tmp.c_str());
+    throw RuntimeError(path + ": cannot write the output (" + ec.message() + ")");
+  }
+}
+
+void run(const IrradianceOptions& o) {
+  if (o.scene.empty() == o.envmap.empty()) throw InputError("lumar irradiance: give either --scene S or --envmap MAP.exr");
+  const Query q = read_queries(o.query);
+  std::unique_ptr<Scene> scene;
+  std::string method = o.method;
+  if (!o.scene.empty()) {
+    scene = std::make_unique<Scene>(load_scene(o.scene));
+    if (method.empty()) method = scene_lighting_method(*scene);
+  }
+  if (method.empty()) method = "volume";
+  std::vector<glm::dvec3> e;
+  if (method == "reference") {
+    std::unique_ptr<RoomRadiance> radiance;
+    if (scene) {
+      radiance = scene_radiance(*scene, reference_radiance_settings());
+    } else {
+      e = texel_sum_irradiance(load_environment_map(o.envmap), q.normals);
+    }
+    if (radiance && radiance->distant()) e = texel_sum_irradiance(radiance->working_map(), q.normals);
+    else if (radiance) e = reference_irradiance(*radiance, q.points, q.normals, o.strata);
+    if (radiance) spdlog::info("reference: {} rays, {} used the fallback", radiance->traced_rays(), radiance->fallback_rays());
+  } else {
+    Scene distant;
+    if (!scene) {
+      distant.manifest = o.envmap;
+      distant.environment_map = o.envmap;
+      distant.distant_map = true;
+    }
+    const Scene& s = scene ? *scene : distant;
+    const VolumeSettings settings = scene_volume_settings(s, method);
+    const auto radiance = scene_radiance(s, settings.radiance);
+    bool loaded = false;
+    IrradianceVolume volume =
+        o.no_cache ? IrradianceVolume::build(*radiance, s.movement_min, s.movement_max, settings)
+                   : cached_irradiance_volume(*radiance, s.movement_min, s.movement_max, settings, o.cache, &loaded);
+    const auto& st = volume.stats();
+    spdlog::info("irradiance volume ({}): {} {} probes ({} moved, {} disabled), {} cells ({} refined), {:.0f} ms, "
+                 "{} rays, {} fallback",
+                 settings.describe(), loaded ? "loaded" : "built", st.probes, st.moved, st.disabled, st.cells,
+                 st.refined_cells, st.build_ms, st.rays, st.fallback_rays);
+    for (std::size_t i = 0; i < q.points.size(); ++i) e.push_back(volume.evaluate(q.points[i], q.normals[i]));
+  }
+  write_results(o.out, e);
+}
+
+}  // namespace
+
+void register_irradiance(CLI::App& app) {
+  auto o = std::make_shared<IrradianceOptions>();
+  auto* cmd = app.add_subcommand("irradiance", "Irradiance at query points from the scene's room and map");
+  auto* scene = cmd->add_option("--scene", o->scene, "Scene manifest (scene.json)");
+  cmd->add_option("--envmap", o->envmap, "A distant HDR map alone, instead of --scene")->excludes(scene);
+  cmd->add_option("--query", o->query, "CSV with header and columns x,y,z,nx,ny,nz")->required();
+  cmd->add_option("--out", o->out, "Output CSV: header r,g,b, one line per query")->required();
+  cmd->add_option("--method", o->method,
+                  "reference, volume (default), sh9, octahedral, lights or greger2004 (the scene's lighting.method "
+                  "when not given)");
+  cmd->add_option("--cache", o->cache, "Volume cache folder (default $XDG_CACHE_HOME/lumar)");
+  cmd->add_flag("--no-cache", o->no_cache, "Build the volume without reading or writing the cache");
+  cmd->add_option("--strata", o->strata, "Reference: strata per axis (strata^2 rays per query)")
+      ->check(CLI::Range(2, 1024))
+      ->capture_default_str();
+  add_action(cmd, [o] { run(*o); });
+}
+
+}  // namespace lumar::app

@@ -1,0 +1,205 @@
+// Shadow lines (issue 8): per-frame update of the figurine's shadow on the sample room's
+// floor while the figurine moves, on ONE core, for several line counts with the shaft
+// hierarchy on and off, against the 2004 method (bounding sphere, thresholded emitters);
+// each entry's error is the mean absolute attenuation error against brute-force ray
+// integration where the reference is below 0.98. Also the precompute time (TBB, all cores).
+#include <benchmark/benchmark.h>
+#include <tbb/global_control.h>
+
+#include <chrono>
+#include <cmath>
+#include <fmt/format.h>
+#include <glm/gtc/matrix_transform.hpp>
+#include <map>
+#include <memory>
+
+#include "bench_report.h"
+#include "lumar/core/scene.h"
+#include "lumar/core/shadow_methods.h"
+#include "lumar/core/shadow_occlusion.h"
+
+using namespace lumar;
+
+namespace {
+
+struct Setup {
+  std::unique_ptr<ShadowScene> scene;
+  Mesh receivers;
+  glm::dmat4 base_pose{1.0};
+  std::vector<glm::vec3> reference;  // attenuation at the error pose
+};
+
+Setup& setup() {
+  static Setup s = [] {
+    Setup out;
+    Scene manifest = load_scene(std::filesystem::path(LUMAR_SOURCE_DIR) / "data/scenes/room/scene.json");
+    manifest.shadows.receiver_vertices = 3200;
+    out.base_pose = manifest.objects.at(0).T_world_model;
+    out.scene = std::make_unique<ShadowScene>(manifest);
+    out.receivers = out.scene->receivers();
+    return out;
+  }();
+  return s;
+}
+
+// The figurine's pose at frame k: gliding over the floor, turning, bobbing 5-25 cm up.
+glm::dmat4 pose_at(int k) {
+  const double t = 0.02 * k;
+  const glm::dvec3 offset(-0.4 + 0.35 * std::cos(t), 0.15 + 0.1 * std::sin(1.7 * t), 0.4 + 0.35 * std::sin(t));
+  return glm::translate(glm::dmat4(1.0), offset) * glm::rotate(glm::dmat4(1.0), 0.3 * t, glm::dvec3(0, 1, 0)) *
+         glm::translate(glm::dmat4(1.0), glm::dvec3(0, 0, 0)) * setup().base_pose;
+}
+glm::dmat4 error_pose() { return pose_at(0); }
+
+EmitterOptions emitter_options(int samples) {
+  EmitterOptions o;
+  o.fixed_patches = 50;
+  o.samples_per_patch = samples;
+  return o;
+}
+
+struct Built {
+  std::unique_ptr<LineShadows> shadows;
+  double precompute_ms = 0;
+  std::size_t lines = 0, candidates = 0;
+};
+
+Built build(int samples) {
+  Setup& s = setup();
+  const auto t0 = std::chrono::steady_clock::now();
+  const Emitters e = s.scene->emitters(s.receivers.positions, s.receivers.normals, emitter_options(samples));
+  ShadowLines lines = build_shadow_lines(s.receivers.positions, s.receivers.normals, e, s.scene->proxy());
+  Built b;
+  b.precompute_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  b.lines = lines.lines.size();
+  b.candidates = lines.candidate_lines;
+  b.shadows = std::make_unique<LineShadows>(std::move(lines));
+  b.shadows->add_object(s.scene->objects().at(0).model, error_pose());
+  return b;
+}
+
+double error_of(const std::vector<glm::vec3>& a) {
+  const auto& ref = setup().reference;
+  double sum = 0;
+  std::size_t n = 0;
+  for (std::size_t i = 0; i < a.size(); ++i)
+    for (int c = 0; c < 3; ++c)
+      if (ref[i][c] < 0.98) sum += std::abs(a[i][c] - ref[i][c]), ++n;
+  return n ? sum / double(n) : 0.0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  Setup& s = setup();
+  const auto& fig = s.scene->objects().at(0);
+  if (std::getenv("LUMAR_SHADOW_BENCH_QUICK")) s.reference.assign(s.receivers.positions.size(), glm::vec3(1.0f));
+  else {
+    std::vector<ShadowScene::Object> objects{{fig.name, fig.model, error_pose()}};
+    EnvironmentMap map = s.scene->map();
+    const ShadowScene posed(std::move(map), false, s.scene->room(), std::move(objects));
+    s.reference = shadow_attenuation(posed, s.receivers.positions, s.receivers.normals, ShadowMethod::Reference);
+  }
+  fmt::print("{} receivers; reference computed\n", s.receivers.positions.size());
+
+  const std::vector<int> samples = {1, 2, 4, 8};
+  std::map<int, Built> built;
+  std::map<std::string, double> errors;
+  std::map<std::string, std::size_t> line_counts;
+  for (int k : samples) {
+    built[k] = build(k);
+    Built& b = built[k];
+    b.shadows->set_object_pose(0, error_pose());
+    b.shadows->update();
+    const double err = error_of(b.shadows->attenuation());
+    for (bool cull : {true, false}) {
+      const std::string name = fmt::format("lines/{}/{}", k, cull ? "culled" : "all");
+      errors[name] = err;
+      line_counts[name] = b.lines;
+      benchmark::RegisterBenchmark(name.c_str(), [&b, cull](benchmark::State& state) {
+        tbb::global_control one_core(tbb::global_control::max_allowed_parallelism, 1);
+        b.shadows->set_culling(cull);
+        int frame = 1;
+        std::size_t traced = 0, tested = 0, blocked = 0, inside = 0;
+        double cull_ms = 0, trace_ms = 0;
+        for (auto _ : state) {
+          b.shadows->set_object_pose(0, pose_at(frame++));
+          b.shadows->update();
+          traced += b.shadows->stats().rays_traced;
+          tested += b.shadows->stats().lines_tested;
+          blocked += b.shadows->stats().lines_blocked;
+          inside += b.shadows->stats().lines_inside;
+          cull_ms += b.shadows->stats().cull_ms;
+          trace_ms += b.shadows->stats().trace_ms;
+        }
+        state.counters["cull_ms"] = cull_ms / double(state.iterations());
+        state.counters["trace_ms"] = trace_ms / double(state.iterations());
+        const double n = double(state.iterations());
+        state.counters["rays"] = double(traced) / n;
+        state.counters["tested"] = double(tested) / n;
+        state.counters["blocked"] = double(blocked) / n;
+        state.counters["inside"] = double(inside) / n;
+      })->Unit(benchmark::kMillisecond)->MinTime(1.0);
+    }
+  }
+
+  // The 2004 method per frame: every line against the bounding sphere.
+  const Emitters thresholded = s.scene->emitters(s.receivers.positions, s.receivers.normals,
+                                                 sphere_baseline_emitter_options());
+  {
+    const std::vector<BoundingSphere> spheres{bounding_sphere(fig.model, error_pose())};
+    errors["sphere"] = error_of(sphere_attenuation(s.receivers.positions, s.receivers.normals, thresholded,
+                                                   s.scene->proxy(), spheres));
+  }
+  benchmark::RegisterBenchmark("sphere", [&](benchmark::State& state) {
+    tbb::global_control one_core(tbb::global_control::max_allowed_parallelism, 1);
+    int frame = 1;
+    for (auto _ : state) {
+      const std::vector<BoundingSphere> spheres{bounding_sphere(fig.model, pose_at(frame++))};
+      benchmark::DoNotOptimize(
+          sphere_attenuation(s.receivers.positions, s.receivers.normals, thresholded, s.scene->proxy(), spheres));
+    }
+  })->Unit(benchmark::kMillisecond)->MinTime(1.0);
+
+  benchmark::Initialize(&argc, argv);
+  bench::CollectingReporter reporter;
+  benchmark::RunSpecifiedBenchmarks(&reporter);
+
+  bench::BenchReport report;
+  report.name = "shadow_error_vs_time";
+  report.title = fmt::format("Moving figurine's shadow, {} receivers x 50 patches, one core",
+                             s.receivers.positions.size());
+  report.baseline = "2004 sphere";
+  report.error_label = "mean |attenuation - reference| where reference < 0.98";
+  for (const auto& [key, err] : errors) {
+    const auto* r = reporter.find(key);
+    if (!r) continue;
+    std::string name = key == "sphere" ? "2004 sphere"
+                                       : fmt::format("{}k lines, {}", line_counts[key] / 1000,
+                                                     key.ends_with("culled") ? "culled" : "all traced");
+    report.entries.push_back({name, r->time_ms, err});
+  }
+  report.compute_ratios();
+
+  const Built& big = built.at(8);
+  const auto* culled = reporter.find("lines/8/culled");
+  const auto* all = reporter.find("lines/8/all");
+  const double speedup = culled && all ? all->time_ms / culled->time_ms : 0.0;
+  report.note = fmt::format(
+      "{} lines (8 per pair): {:.2f} ms/frame culled, {:.1f} ms all traced ({:.0f}x); precompute "
+      "3200x50 (1 line/pair) {:.0f} ms, 8 lines/pair {:.0f} ms",
+      big.lines, culled ? culled->time_ms : 0.0, all ? all->time_ms : 0.0, speedup, built.at(1).precompute_ms,
+      big.precompute_ms);
+  report.save(bench::results_dir());
+  // The chart also lives beside the shadow docs.
+  std::filesystem::copy_file(bench::results_dir() / "shadow_error_vs_time.png",
+                             std::filesystem::path(LUMAR_SOURCE_DIR) / "docs/shadow_error_vs_time.png",
+                             std::filesystem::copy_options::overwrite_existing);
+  fmt::print("{}\n", report.note);
+  for (int k : samples)
+    fmt::print("samples/patch {}: {} lines kept of {} candidates, precompute {:.0f} ms, error {:.4f}\n", k,
+               built[k].lines, built[k].candidates, built[k].precompute_ms,
+               errors[fmt::format("lines/{}/culled", k)]);
+  fmt::print("2004 sphere error {:.4f}\n", errors["sphere"]);
+  return 0;
+}

@@ -1,0 +1,127 @@
+#include "lumar/calib/rig_recording.h"
+
+#include <string>
+
+#include "lumar/calib/board_pose.h"
+#include "lumar/capture/durable_file.h"
+#include "lumar/capture/recording_format.h"
+#include "lumar/capture/recording_reader.h"
+#include "lumar/core/error.h"
+#include "lumar/tracking/pose_conversion.h"
+#include "lumar/tracking/record_codec.h"
+#include "lumar/tracking/record_parser.h"
+#include "lumar/tracking/timestamping.h"
+
+namespace lumar::calib {
+
+namespace {
+
+std::string size_text(cv::Size s) { return std::to_string(s.width) + "x" + std::to_string(s.height); }
+
+}  // namespace
+
+RigRecording load_rig_recording(const std::filesystem::path& dir, cv::Size inner_corners, double square_size_m,
+                                const std::optional<CameraIntrinsics>& camera, int every) {
+  if (inner_corners.width < 2 || inner_corners.height < 2)
+    throw InputError("--board " + size_text(inner_corners) + ": give the inner corners, e.g. 9x6");
+  if (!(square_size_m > 0)) throw InputError("--square: must be a positive length in metres");
+  if (every < 1) throw InputError("--every: must be 1 or more");
+  if (!std::filesystem::is_directory(dir))
+    throw InputError(dir.string() + ": recording not found; give a recording directory");
+  const capture::RecordingReader reader(dir);
+  const std::string session_file = (dir / capture::kSessionFile).string();
+  RigRecording out;
+  out.session = capture::session_from_json(reader.session(), session_file);
+  out.camera = camera ? *camera : out.session.camera;
+  const cv::Size video_size = reader.video().size;
+  if (!video_size.empty() && (video_size.width != out.camera.width || video_size.height != out.camera.height))
+    throw InputError(session_file + ": video is " + size_text(video_size) + " but the camera calibration is " +
+                     std::to_string(out.camera.width) + "x" + std::to_string(out.camera.height) +
+                     "; use the calibration of this camera mode");
+
+  // Tracker: the raw bytes through the real parser, as capture::RecordingReplay does.
+  const capture::TrackerSettings& t = out.session.tracker;
+  if (t.encoding != "ascii" && t.encoding != "binary")
+    throw InputError(session_file + ": tracker encoding '" + t.encoding + "' is unknown; use ascii or binary");
+  tracking::TrackerFormat format;
+  try {
+    format = tracking::TrackerFormat::of(tracking::parse_device(t.device), t.encoding == "binary",
+                                         {t.output_list, t.centimetres});
+    tracking::validate_tracker_format(format);
+  } catch (const InputError& e) {
+    throw InputError(session_file + ": " + e.what());
+  }
+  tracking::RecordParser parser(format, t.baud);
+  for (const auto& chunk : reader.tracker_chunks()) {
+    parser.push(chunk);
+    for (const auto& r : parser.take_all()) {
+      if (r.record.station != t.station) continue;
+      const Nanos time = tracking::measurement_time(r.first_byte_arrival, t.baud, out.session.rig.latency);
+      if (auto sample = tracking::to_pose_sample(r.record, format.output, time)) {
+        out.tracker.add(*sample);
+        ++out.tracker_records;
+      }
+    }
+  }
+  if (out.tracker_records == 0)
+    throw InputError((dir / capture::kTrackerFile).string() + ": no tracker records for station " +
+                     std::to_string(t.station) + "; record the tracker while filming the board");
+
+  auto frames = reader.open_frames();
+  capture::Frame frame;
+  while (frames->read(frame)) {
+    if (out.frames++ % every != 0) continue;
+    if (frame.image.cols != out.camera.width || frame.image.rows != out.camera.height)
+      throw InputError(dir.string() + ": frame " + std::to_string(frame.index) + " is " + size_text(frame.image.size()) +
+                       " but the camera calibration is " + std::to_string(out.camera.width) + "x" +
+                       std::to_string(out.camera.height));
+    // Adaptive thresholding only once the board size has proved right: a wrong --board
+    // would otherwise cost a quarter of a second per frame.
+    if (auto pose = find_board_pose(frame.image, inner_corners, square_size_m, out.camera, !out.views.empty()))
+      out.views.push_back({frame.index, frame.time, pose->T_camera_board, pose->reprojection_rms_px});
+  }
+  if (out.views.empty())
+    throw InputError(dir.string() + ": no " + size_text(inner_corners) + " board found in any of the " +
+                     std::to_string(out.frames) + " frames; check --board (inner corners, not squares)");
+  return out;
+}
+
+nlohmann::json rig_calibration_json(const RigCalibrationResult& r) {
+  nlohmann::json warnings = r.warnings;
+  return {{"T_sensor_camera", tracking::pose_to_json(r.rig.T_sensor_camera)},
+          {"T_world_transmitter", tracking::pose_to_json(r.rig.T_world_transmitter)},
+          {"latency_ns", r.rig.latency},
+          {"assumed_latency_ns", r.assumed_latency},
+          {"time_offset_ns", r.time_offset},
+          {"correlation_offset_ns", r.correlation_offset},
+          {"peak_correlation", r.peak_correlation},
+          {"correlation_at_zero", r.correlation_at_zero},
+          {"hand_eye_T_sensor_camera", tracking::pose_to_json(r.hand_eye.T_sensor_camera)},
+          {"hand_eye_views", r.hand_eye.views_used.size()},
+          {"hand_eye_min_pair_rotation_deg", r.hand_eye.min_pair_rotation_deg},
+          {"views_given", r.views_given},
+          {"views_used", r.views_used},
+          {"views_rejected_pnp", r.views_rejected_pnp},
+          {"samples_used", r.samples_used},
+          {"samples_rejected_residual", r.samples_rejected_residual},
+          {"median_view_rms_px", r.median_view_rms_px},
+          {"view_rms_threshold_px", r.view_rms_threshold_px},
+          {"rotation_range_deg", r.rotation_range_deg},
+          {"residual_rotation_rms_deg", r.rotation_rms_deg},
+          {"residual_translation_rms_m", r.translation_rms_m},
+          {"sigma_rotation_deg", r.sigma_rotation_deg},
+          {"sigma_translation_m", r.sigma_translation_m},
+          {"sigma_time_offset_s", r.sigma_time_offset_s},
+          {"warnings", warnings}};
+}
+
+void save_rig_to_session(const std::filesystem::path& dir, const RigCalibrationResult& result) {
+  const capture::RecordingReader reader(dir);
+  const std::filesystem::path file = dir / capture::kSessionFile;
+  capture::Session session = capture::session_from_json(reader.session(), file.string());
+  session.rig = result.rig;
+  session.extra["rig_calibration"] = rig_calibration_json(result);
+  capture::write_file_atomically(file, capture::session_to_json(session).dump(2) + "\n");
+}
+
+}  // namespace lumar::calib

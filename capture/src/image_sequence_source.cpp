@@ -1,0 +1,152 @@
+#include "lumar/capture/image_sequence_source.h"
+
+#include <glob.h>
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+#include <set>
+
+#include "csv_text.h"
+#include "lumar/core/error.h"
+
+namespace lumar::capture {
+namespace fs = std::filesystem;
+
+namespace {
+
+bool is_image(const fs::path& p) {
+  static const std::set<std::string> kExtensions{".png", ".jpg", ".jpeg", ".bmp", ".tif", ".tiff", ".ppm"};
+  std::string ext = p.extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+  return kExtensions.count(ext) > 0;
+}
+
+std::vector<fs::path> expand(const std::string& pattern) {
+  std::vector<fs::path> out;
+  std::error_code ec;
+  if (fs::is_directory(pattern, ec)) {
+    for (const auto& e : fs::directory_iterator(pattern, ec))
+      if (e.is_regular_file() && is_image(e.path())) out.push_back(e.path());
+  } else {
+    glob_t g{};
+    if (::glob(pattern.c_str(), 0, nullptr, &g) == 0)
+      for (std::size_t i = 0; i < g.gl_pathc; ++i)
+        if (fs::is_regular_file(g.gl_pathv[i], ec)) out.emplace_back(g.gl_pathv[i]);
+    globfree(&g);
+  }
+  std::sort(out.begin(), out.end(),
+            [](const fs::path& a, const fs::path& b) { return natural_less(a.string(), b.string()); });
+  return out;
+}
+
+// The folder the images live in: the pattern itself, or the folder part of a glob.
+fs::path image_folder(const std::string& pattern) {
+  std::error_code ec;
+  if (fs::is_directory(pattern, ec)) return pattern;
+  return fs::path(pattern).parent_path();
+}
+
+}  // namespace
+
+bool natural_less(const std::string& a, const std::string& b) {
+  std::size_t i = 0, j = 0;
+  while (i < a.size() && j < b.size()) {
+    if (std::isdigit((unsigned char)a[i]) && std::isdigit((unsigned char)b[j])) {
+      std::size_t ie = i, je = j;
+      while (ie < a.size() && std::isdigit((unsigned char)a[ie])) ++ie;
+      while (je < b.size() && std::isdigit((unsigned char)b[je])) ++je;
+      // Compare as numbers without overflow: strip leading zeros, then length, then text.
+      std::size_t is = i, js = j;
+      while (is + 1 < ie && a[is] == '0') ++is;
+      while (js + 1 < je && b[js] == '0') ++js;
+      if (ie - is != je - js) return ie - is < je - js;
+      const int c = a.compare(is, ie - is, b, js, je - js);
+      if (c != 0) return c < 0;
+      if (ie - i != je - j) return ie - i < je - j;  // "01" after "1"
+      i = ie;
+      j = je;
+    } else {
+      if (a[i] != b[j]) return a[i] < b[j];
+      ++i;
+      ++j;
+    }
+  }
+  return a.size() - i < b.size() - j;
+}
+
+ImageSequenceSource::ImageSequenceSource(ImageSequenceSettings settings) : settings_(std::move(settings)) {
+  const std::string& pattern = settings_.pattern;
+  if (pattern.empty()) throw InputError("images: no folder or glob given; use e.g. images:shots/ or 'images:shots/*.png'");
+  if (settings_.timestamps.empty()) {
+    if (!(settings_.fps > 0) || !std::isfinite(settings_.fps))
+      throw InputError(pattern + ": an image sequence needs a timestamp table or a frame rate (--fps)");
+    files_ = expand(pattern);
+    if (files_.empty())
+      throw InputError(pattern + ": no image files (png, jpg, bmp, tif, ppm) found; check the folder or glob");
+    for (std::size_t i = 0; i < files_.size(); ++i)
+      times_.push_back(Nanos(std::llround(double(i) * 1e9 / settings_.fps)));
+    fps_ = settings_.fps;
+  } else {
+    const fs::path& table = settings_.timestamps;
+    const fs::path folder = image_folder(pattern);
+    const std::string text = csv::read_file(table);
+    std::size_t line = 0, at = 0;
+    while (at < text.size()) {
+      const std::size_t end = text.find('\n', at);
+      if (end == std::string::npos) break;  // a torn last line: ignored, as in recordings
+      const std::string row = text.substr(at, end - at);
+      at = end + 1;
+      ++line;
+      const std::string where = table.string() + ":" + std::to_string(line) + ": ";
+      if (line == 1) {
+        if (row != "file,time_ns") throw InputError(where + "header must be 'file,time_ns'");
+        continue;
+      }
+      if (row.empty()) continue;
+      const std::size_t comma = row.rfind(',');
+      if (comma == std::string::npos || comma == 0) throw InputError(where + "expected file,time_ns");
+      Nanos t = 0;
+      const char* first = row.data() + comma + 1;
+      const char* last = row.data() + row.size();
+      auto [ptr, ec] = std::from_chars(first, last, t);
+      if (ec != std::errc() || ptr != last || first == last)
+        throw InputError(where + "time_ns '" + row.substr(comma + 1) + "' is not an integer");
+      if (!times_.empty() && t <= times_.back())
+        throw InputError(where + "time " + std::to_string(t) + " does not increase; the rows must be in time order");
+      const fs::path file = folder / row.substr(0, comma);
+      if (std::error_code e; !fs::is_regular_file(file, e))
+        throw InputError(where + "no such image " + file.string());
+      files_.push_back(file);
+      times_.push_back(t);
+    }
+    if (files_.empty()) throw InputError(table.string() + ": the timestamp table lists no frames");
+    if (times_.size() > 1) fps_ = double(times_.size() - 1) / nanos_to_seconds(times_.back() - times_.front());
+  }
+  size_ = decode(0).size();
+}
+
+cv::Mat ImageSequenceSource::decode(std::size_t i) const {
+  cv::Mat img = cv::imread(files_[i].string(), cv::IMREAD_COLOR);  // BGR8, whatever the file holds
+  if (img.empty())
+    throw InputError(files_[i].string() + ": cannot decode this image; it is corrupt or not an image");
+  return img;
+}
+
+bool ImageSequenceSource::read(Frame& frame) {
+  if (next_ >= files_.size()) return false;
+  const std::size_t i = next_++;  // a bad file is reported once, then skipped
+  cv::Mat img = decode(i);
+  if (img.size() != size_)
+    throw InputError(files_[i].string() + ": is " + std::to_string(img.cols) + "x" + std::to_string(img.rows) +
+                     ", the sequence started at " + std::to_string(size_.width) + "x" +
+                     std::to_string(size_.height) + "; every image must have the same size");
+  frame.image = img;
+  frame.time = times_[i];
+  frame.index = std::int64_t(i);
+  return true;
+}
+
+}  // namespace lumar::capture

@@ -1,0 +1,146 @@
+// The overlay path: rendering the sample recording's view (the camera of frame 15 of
+// recordings/orbit, its true pose), the video darkens under the figurine by the
+// attenuation the CPU computed at the receiver vertices, and nowhere else (compared to
+// the same frame with shadows off).
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <glm/gtc/matrix_transform.hpp>
+#include <nlohmann/json.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <sstream>
+
+#include "lumar/core/color.h"
+#include "lumar/core/compositor.h"
+#include "lumar/core/gl/context.h"
+#include "lumar/core/shadow_occlusion.h"
+#include "test_paths.h"
+
+namespace lumar {
+namespace {
+
+gl::Context& context() {
+  static std::unique_ptr<gl::Context> c = gl::create_headless_context();
+  c->make_current();
+  return *c;
+}
+
+// The recording's (distorted) camera without distortion, and the true pose of one frame.
+void recording_view(int frame, CameraIntrinsics& camera, Pose& pose) {
+  const auto dir = test::source_dir() / "recordings/orbit";
+  std::ifstream js(dir / "session.json");
+  const nlohmann::json session = nlohmann::json::parse(js);
+  const auto& c = session.at("camera");
+  camera.width = c.at("width"), camera.height = c.at("height");
+  camera.fx = c.at("fx"), camera.fy = c.at("fy"), camera.cx = c.at("cx"), camera.cy = c.at("cy");
+  std::ifstream truth(dir / "truth.csv");
+  std::string line;
+  std::getline(truth, line);
+  while (std::getline(truth, line)) {
+    std::stringstream ss(line);
+    std::string cell;
+    std::vector<double> v;
+    while (std::getline(ss, cell, ',')) v.push_back(std::stod(cell));
+    if (int(v.at(0)) != frame) continue;
+    pose.translation = {v[2], v[3], v[4]};
+    pose.rotation = glm::normalize(glm::dquat(v[5], v[6], v[7], v[8]));
+    return;
+  }
+  FAIL() << "frame " << frame << " not in truth.csv";
+}
+
+cv::Mat linear(const cv::Mat& bgr8) {
+  cv::Mat out(bgr8.size(), CV_32FC3);
+  for (int r = 0; r < bgr8.rows; ++r)
+    for (int c = 0; c < bgr8.cols; ++c)
+      for (int k = 0; k < 3; ++k)
+        out.at<cv::Vec3f>(r, c)[k] = srgb_to_linear(bgr8.at<cv::Vec3b>(r, c)[k] / 255.0f);
+  return out;
+}
+
+TEST(ShadowOverlay, VideoDarkensWhereTheLinesSayAndNowhereElse) {
+  context();
+  CameraIntrinsics camera;
+  Pose pose;
+  recording_view(15, camera, pose);
+  Scene scene = load_scene(test::source_dir() / "data/scenes/room/scene.json");
+  // Lift the figurine a little so that its shadow is a visible patch, not only contact.
+  const glm::dmat4 T = glm::translate(glm::dmat4(1.0), glm::dvec3(0, 0.12, 0)) * scene.objects[0].T_world_model;
+  Compositor compositor(scene, camera, cv::Mat(), cv::Mat());
+  compositor.set_object_pose(0, T);
+  ASSERT_NE(compositor.shadows(), nullptr);
+  const double exposure = 0.66;
+
+  // The "video": the proxy room's radiance seen from this pose, encoded as the camera would.
+  const cv::Mat radiance = compositor.renderer().render_room_radiance(camera, pose);
+  cv::Mat video(radiance.size(), CV_8UC3);
+  for (int r = 0; r < video.rows; ++r)
+    for (int c = 0; c < video.cols; ++c)
+      for (int k = 0; k < 3; ++k)
+        video.at<cv::Vec3b>(r, c)[k] = cv::saturate_cast<uchar>(
+            255.0f * linear_to_srgb(std::min(1.0f, float(exposure) * radiance.at<cv::Vec3f>(r, c)[k])) + 0.5f);
+
+  compositor.set_shadows_enabled(true);
+  const cv::Mat on = compositor.composite(video, pose, exposure);
+  const LineShadows& shadows = *compositor.shadows();
+  compositor.set_shadows_enabled(false);
+  const cv::Mat off = compositor.composite(video, pose, exposure);
+  const auto out_dir = test::scratch_dir("shadow_overlay");
+  cv::imwrite((out_dir / "on.png").string(), on);
+  cv::imwrite((out_dir / "off.png").string(), off);
+  cv::Mat diff;
+  cv::absdiff(on, off, diff);
+  cv::imwrite((out_dir / "difference_x8.png").string(), diff * 8);
+  const cv::Mat object_mask = compositor.renderer().render_object_mask(pose);
+  const cv::Mat lin_on = linear(on), lin_off = linear(off);
+
+  // Where the CPU predicts a shadow, the pixel at the vertex darkens by that ratio.
+  const auto& origins = shadows.lines().origins;
+  const auto& att = shadows.attenuation();
+  const glm::dmat4 T_camera_world = pose.inverse().matrix();
+  int checked = 0;
+  double worst = 0;
+  for (std::size_t i = 0; i < origins.size(); ++i) {
+    if (att[i].g > 0.9f) continue;
+    const glm::dvec3 pc = glm::dvec3(T_camera_world * glm::dvec4(glm::dvec3(origins[i]), 1.0));
+    if (pc.z <= 0.1) continue;
+    const glm::dvec2 uv = project_pinhole(camera, pc);
+    const int u = int(std::lround(uv.x)), v = int(std::lround(uv.y));
+    if (u < 1 || v < 1 || u >= camera.width - 1 || v >= camera.height - 1) continue;
+    if (object_mask.at<uchar>(v, u) || object_mask.at<uchar>(v - 1, u) || object_mask.at<uchar>(v + 1, u)) continue;
+    const float base = lin_off.at<cv::Vec3f>(v, u)[1];
+    if (base < 0.02f) continue;
+    const double ratio = lin_on.at<cv::Vec3f>(v, u)[1] / base;
+    worst = std::max(worst, std::abs(ratio - att[i].g));
+    EXPECT_NEAR(ratio, att[i].g, 0.06) << "vertex " << i << " at pixel " << u << "," << v;
+    ++checked;
+  }
+  std::printf("checked %d shadowed vertices in view; worst |ratio - attenuation| %.4f\n", checked, worst);
+  EXPECT_GE(checked, 10);
+
+  // Nowhere else: every pixel that changed sees the floor near a shadowed vertex.
+  const glm::dvec3 eye = pose.translation;
+  int changed = 0, unexplained = 0;
+  for (int v = 0; v < on.rows; ++v)
+    for (int u = 0; u < on.cols; ++u) {
+      const cv::Vec3b a = on.at<cv::Vec3b>(v, u), b = off.at<cv::Vec3b>(v, u);
+      if (std::abs(int(a[1]) - int(b[1])) <= 1) continue;
+      ++changed;
+      EXPECT_LT(int(a[1]), int(b[1])) << "shadows only darken";
+      // The floor point this pixel sees (y = 0).
+      const glm::dvec3 ray = pose.rotation_matrix() * glm::dvec3((u - camera.cx) / camera.fx, (v - camera.cy) / camera.fy, 1.0);
+      bool near_shadow = false;
+      if (ray.y < 0) {
+        const glm::dvec3 p = eye + (-eye.y / ray.y) * ray;
+        for (std::size_t i = 0; i < origins.size() && !near_shadow; ++i)
+          near_shadow = att[i].g < 0.995f && glm::length(glm::dvec3(origins[i]) - p) < 0.1;
+      }
+      unexplained += !near_shadow;
+    }
+  std::printf("%d pixels darkened, %d of them away from a predicted shadow\n", changed, unexplained);
+  EXPECT_GT(changed, 100);
+  EXPECT_EQ(unexplained, 0);
+}
+
+}  // namespace
+}  // namespace lumar
