@@ -96,7 +96,7 @@ int main(int argc, char** argv) {
                     {"upload frame", c.at("upload_ms")},
                     {"background (undistort)", c.at("background_ms")},
                     {"proxy depth", c.at("depth_ms")},
-                    {"virtual objects (SH9)", c.at("objects_ms")},
+                    {"virtual objects (volume)", c.at("objects_ms")},
                     {"read back", c.at("readback_ms")},
                     {"composite, all stages", composite->time_ms},
                     {"replay: decode+pose+composite", replay->time_ms}};
