@@ -200,16 +200,8 @@ void synthesize_board_recording(const BoardSynthSettings& s) {
   const Nanos duration = start + frame_period * frames + seconds_to_nanos(0.5);
   auto true_camera = [&](Nanos t) { return board_synth_camera_pose(nanos_to_seconds(t), s.board, s.square); };
 
-  tracking::SimulatedTrackerSettings ts;
-  ts.rate_hz = session.tracker.rate_hz;
-  ts.baud = session.tracker.baud;
-  ts.device_latency = truth.latency;
-  ts.orientation_noise_deg = s.tracker_noise_deg;
-  ts.position_noise_m = s.position_noise_m;
-  ts.seed = s.seed;
-  ts.station = session.tracker.station;
-  const auto tracker =
-      tracking::simulate_tracker([&](Nanos t) { return truth.sensor_pose(true_camera(t)); }, duration, ts);
+  const auto tracker = simulate_session_tracker(session, truth.latency, s.tracker_noise_deg, s.position_noise_m, s.seed,
+                                                [&](Nanos t) { return truth.sensor_pose(true_camera(t)); }, duration);
 
   capture::RecordingSettings rs;
   rs.codec = s.codec;

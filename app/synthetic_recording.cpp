@@ -33,6 +33,22 @@ Pose look_at(const glm::dvec3& eye, const glm::dvec3& target) {
   return p;
 }
 
+tracking::SimulatedTrackerOutput simulate_session_tracker(const capture::Session& session, Nanos device_latency,
+                                                          double orientation_noise_deg, double position_noise_m,
+                                                          std::uint64_t seed,
+                                                          const std::function<Pose(Nanos)>& true_sensor_pose,
+                                                          Nanos duration) {
+  tracking::SimulatedTrackerSettings ts;
+  ts.rate_hz = session.tracker.rate_hz;
+  ts.baud = session.tracker.baud;
+  ts.station = session.tracker.station;
+  ts.device_latency = device_latency;
+  ts.orientation_noise_deg = orientation_noise_deg;
+  ts.position_noise_m = position_noise_m;
+  ts.seed = seed;
+  return tracking::simulate_tracker(true_sensor_pose, duration, ts);
+}
+
 void write_tracker_stream(capture::RecordingWriter& writer, const tracking::SimulatedTrackerOutput& tracker,
                           const capture::TrackerSettings& settings, Nanos assumed_latency) {
   tracking::OutputFormat format;
@@ -158,16 +174,9 @@ void synthesize_recording(const SynthSettings& s) {
     return orbit_camera_pose(target, u, s.arc_deg);
   };
 
-  tracking::SimulatedTrackerSettings ts;
-  ts.rate_hz = session.tracker.rate_hz;
-  ts.baud = session.tracker.baud;
-  ts.device_latency = session.rig.latency;
-  ts.orientation_noise_deg = s.tracker_noise_deg;
-  ts.position_noise_m = s.position_noise_m;
-  ts.seed = s.seed;
-  ts.station = session.tracker.station;
-  const auto tracker = tracking::simulate_tracker(
-      [&](Nanos t) { return session.rig.sensor_pose(true_camera(t)); }, duration, ts);
+  const auto tracker = simulate_session_tracker(session, session.rig.latency, s.tracker_noise_deg, s.position_noise_m,
+                                                s.seed, [&](Nanos t) { return session.rig.sensor_pose(true_camera(t)); },
+                                                duration);
 
   // Exposure: the first view's mean radiance becomes 18 % grey unless given.
   double exposure = s.exposure;

@@ -5,6 +5,7 @@
 // the byte stream a Polhemus ISOTRAK II would send about the same motion.
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <string>
 
 #include "lumar/capture/recording_writer.h"
@@ -37,6 +38,14 @@ struct SynthSettings {
 
 // OpenCV camera axes (x right, y down, z forward) looking from `eye` at `target`, world +Y up.
 Pose look_at(const glm::dvec3& eye, const glm::dvec3& target);
+
+// The tracker of a synthetic recording: the session's protocol (rate, baud, station),
+// the simulated device's own latency, its noise and seed, measuring `true_sensor_pose`.
+tracking::SimulatedTrackerOutput simulate_session_tracker(const capture::Session& session, Nanos device_latency,
+                                                          double orientation_noise_deg, double position_noise_m,
+                                                          std::uint64_t seed,
+                                                          const std::function<Pose(Nanos)>& true_sensor_pose,
+                                                          Nanos duration);
 
 // The tracker's bytes as they arrived (into tracker.raw), and the poses the real ASCII
 // parser decodes from them (into poses.csv), timestamped with `assumed_latency`: the

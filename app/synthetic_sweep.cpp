@@ -135,16 +135,9 @@ void synthesize_sweep(const SynthSettings& s, const SweepSynthSettings& sw) {
                             {"shot_noise_gain", s.shot_noise_gain},
                             {"seed", s.seed}};
 
-  tracking::SimulatedTrackerSettings ts;
-  ts.rate_hz = session.tracker.rate_hz;
-  ts.baud = session.tracker.baud;
-  ts.device_latency = session.rig.latency;
-  ts.orientation_noise_deg = s.tracker_noise_deg;
-  ts.position_noise_m = s.position_noise_m;
-  ts.seed = s.seed;
-  ts.station = session.tracker.station;
-  const auto tracker = tracking::simulate_tracker(
-      [&](Nanos t) { return session.rig.sensor_pose(true_camera(t)); }, duration, ts);
+  const auto tracker = simulate_session_tracker(session, session.rig.latency, s.tracker_noise_deg, s.position_noise_m,
+                                                s.seed, [&](Nanos t) { return session.rig.sensor_pose(true_camera(t)); },
+                                                duration);
 
   calib::SensorModel sensor;
   sensor.read_noise = s.read_noise;

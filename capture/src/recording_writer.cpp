@@ -110,12 +110,16 @@ struct RecordingWriter::Impl {
 
   void flush_logs() {
     std::vector<SyncedLog*> to_sync;
-    for (SyncedLog* log : {&tracker, &poses, &truth}) {
-      std::lock_guard lock(log->mutex);
-      if (!log->dirty) continue;
-      log->file.flush();
-      log->dirty = false;
-      to_sync.push_back(log);
+    {
+      // All three at once: flushed one by one, a pose appended between the tracker's
+      // flush and the poses' flush could reach the disk before its raw bytes.
+      std::scoped_lock lock(tracker.mutex, poses.mutex, truth.mutex);
+      for (SyncedLog* log : {&tracker, &poses, &truth}) {
+        if (!log->dirty) continue;
+        log->file.flush();
+        log->dirty = false;
+        to_sync.push_back(log);
+      }
     }
     // Outside the locks: a slow disk must not stall the tracker thread's appends.
     for (SyncedLog* log : to_sync) log->file.datasync();

@@ -1,6 +1,6 @@
 #pragma once
-// Shared pieces of the renderer tests: one headless context per process, meshes built
-// in code (so the tests need no files), camera poses.
+// Shared pieces of the renderer tests: one headless context per process, camera poses
+// (meshes built in code are in test_meshes.h).
 #include <opencv2/core.hpp>
 
 #include "lumar/core/camera.h"
@@ -8,19 +8,12 @@
 #include "lumar/core/mesh.h"
 #include "lumar/core/pose.h"
 #include "lumar/core/sh.h"
+#include "test_meshes.h"
 
 namespace lumar::test {
 
 // A surfaceless EGL context, made current; created on first use, kept for the process.
 gl::Context& headless_context();
-
-// Closed UV sphere with outward unit normals.
-Mesh make_sphere(const glm::vec3& centre, float radius, int slices, int stacks);
-// Axis-aligned box, 12 triangles, flat face normals pointing outward (inward if `inward`).
-Mesh make_box(const glm::vec3& min, const glm::vec3& max, bool inward = false);
-// A rectangle through `centre` spanned by half-extents `a` and `b`; all four vertex
-// normals are `normal` (need not match the geometry: the shading tests choose it freely).
-Mesh make_quad(const glm::vec3& centre, const glm::vec3& a, const glm::vec3& b, const glm::vec3& normal);
 
 // OpenCV camera at `eye` looking at `target` (+Y world up), rolled by `roll_deg` about its view axis.
 Pose look_at(const glm::dvec3& eye, const glm::dvec3& target, double roll_deg = 0.0);

@@ -64,7 +64,7 @@ TEST(ShadowAcceptance, SphereAboveSampleFloor) {
   Scene s = load_scene(test::source_dir() / "data/scenes/room/scene.json");
   s.objects.clear();
   ShadowScene base(s);
-  std::vector<ShadowScene::Object> objects{{"sphere", test::make_uv_sphere({0, 0, 0}, 0.2f, 48, 24),
+  std::vector<ShadowScene::Object> objects{{"sphere", test::make_sphere({0, 0, 0}, 0.2f, 48, 24),
                                             glm::translate(glm::dmat4(1.0), glm::dvec3(-0.3, 0.45, 0.4))}};
   EnvironmentMap map = base.map();
   const ShadowScene scene(std::move(map), false, base.room(), std::move(objects));

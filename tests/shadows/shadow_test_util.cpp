@@ -8,26 +8,6 @@
 
 namespace lumar::test {
 
-Mesh make_uv_sphere(const glm::vec3& centre, float radius, int slices, int stacks) {
-  Mesh m;
-  for (int i = 0; i <= stacks; ++i) {
-    const double theta = std::numbers::pi * i / stacks;
-    for (int j = 0; j <= slices; ++j) {
-      const double phi = 2.0 * std::numbers::pi * j / slices;
-      const glm::vec3 n(std::sin(theta) * std::cos(phi), std::cos(theta), std::sin(theta) * std::sin(phi));
-      m.positions.push_back(centre + radius * n);
-      m.normals.push_back(n);
-    }
-  }
-  const auto index = [&](int i, int j) { return std::uint32_t(i * (slices + 1) + j); };
-  for (int i = 0; i < stacks; ++i)
-    for (int j = 0; j < slices; ++j) {
-      m.indices.insert(m.indices.end(), {index(i, j), index(i + 1, j), index(i + 1, j + 1)});
-      m.indices.insert(m.indices.end(), {index(i, j), index(i + 1, j + 1), index(i, j + 1)});
-    }
-  return m;
-}
-
 Mesh make_ground(float h, float y) {
   Mesh m;
   m.positions = {{-h, y, -h}, {-h, y, h}, {h, y, h}, {h, y, -h}};

@@ -7,10 +7,10 @@
 
 #include "lumar/core/envmap.h"
 #include "lumar/core/mesh.h"
+#include "test_meshes.h"
 
 namespace lumar::test {
 
-Mesh make_uv_sphere(const glm::vec3& centre, float radius, int slices, int stacks);
 // A square in the y = height plane, facing +Y, split into 2 triangles.
 Mesh make_ground(float half_size, float height = 0.0f);
 // A regular grid of points on the y = height plane around (cx, cz), normals +Y.

@@ -1,0 +1,63 @@
+#include "test_meshes.h"
+
+#include <cmath>
+#include <numbers>
+
+namespace lumar::test {
+
+Mesh make_sphere(const glm::vec3& centre, float radius, int slices, int stacks) {
+  Mesh m;
+  for (int i = 0; i <= stacks; ++i) {
+    const double theta = std::numbers::pi * i / stacks;
+    for (int j = 0; j <= slices; ++j) {
+      const double phi = 2.0 * std::numbers::pi * j / slices;
+      const glm::vec3 n(std::sin(theta) * std::cos(phi), std::cos(theta), std::sin(theta) * std::sin(phi));
+      m.positions.push_back(centre + radius * n);
+      m.normals.push_back(n);
+    }
+  }
+  const auto index = [&](int i, int j) { return std::uint32_t(i * (slices + 1) + j); };
+  for (int i = 0; i < stacks; ++i)
+    for (int j = 0; j < slices; ++j) {
+      m.indices.insert(m.indices.end(), {index(i, j), index(i + 1, j), index(i + 1, j + 1)});
+      m.indices.insert(m.indices.end(), {index(i, j), index(i + 1, j + 1), index(i, j + 1)});
+    }
+  return m;
+}
+
+Mesh make_box(const glm::vec3& lo, const glm::vec3& hi, bool inward) {
+  Mesh m;
+  // Each face: outward normal axis/sign, four corners.
+  for (int axis = 0; axis < 3; ++axis)
+    for (int side = 0; side < 2; ++side) {
+      const int u = (axis + 1) % 3, v = (axis + 2) % 3;
+      glm::vec3 n(0.0f);
+      n[axis] = side ? 1.0f : -1.0f;
+      const std::uint32_t base = std::uint32_t(m.positions.size());
+      for (int k = 0; k < 4; ++k) {
+        glm::vec3 p;
+        p[axis] = side ? hi[axis] : lo[axis];
+        p[u] = (k == 1 || k == 2) ? hi[u] : lo[u];
+        p[v] = (k >= 2) ? hi[v] : lo[v];
+        m.positions.push_back(p);
+        m.normals.push_back(inward ? -n : n);
+      }
+      // Corners 0-1-2-3 run counter-clockwise seen from +axis; reverse them where the
+      // front (the side the normal points to) faces the other way.
+      if ((side == 1) != inward)
+        m.indices.insert(m.indices.end(), {base, base + 1, base + 2, base, base + 2, base + 3});
+      else
+        m.indices.insert(m.indices.end(), {base, base + 2, base + 1, base, base + 3, base + 2});
+    }
+  return m;
+}
+
+Mesh make_quad(const glm::vec3& centre, const glm::vec3& a, const glm::vec3& b, const glm::vec3& normal) {
+  Mesh m;
+  m.positions = {centre - a - b, centre + a - b, centre + a + b, centre - a + b};
+  m.normals.assign(4, glm::normalize(normal));
+  m.indices = {0, 1, 2, 0, 2, 3};
+  return m;
+}
+
+}  // namespace lumar::test

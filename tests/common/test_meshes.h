@@ -1,0 +1,17 @@
+#pragma once
+// Meshes built in code, so that tests need no model files.
+#include <glm/glm.hpp>
+
+#include "lumar/core/mesh.h"
+
+namespace lumar::test {
+
+// Closed UV sphere with outward unit normals.
+Mesh make_sphere(const glm::vec3& centre, float radius, int slices, int stacks);
+// Axis-aligned box, 12 triangles, flat face normals pointing outward (inward if `inward`).
+Mesh make_box(const glm::vec3& min, const glm::vec3& max, bool inward = false);
+// A rectangle through `centre` spanned by half-extents `a` and `b`; all four vertex
+// normals are `normal` (need not match the geometry: the shading tests choose it freely).
+Mesh make_quad(const glm::vec3& centre, const glm::vec3& a, const glm::vec3& b, const glm::vec3& normal);
+
+}  // namespace lumar::test
