@@ -11,6 +11,7 @@
 #include "lumar/calib/calibration_report.h"
 #include "lumar/calib/charuco_calibration.h"
 #include "lumar/calib/video_views.h"
+#include "lumar/capture/source_spec.h"
 #include "lumar/core/error.h"
 
 namespace lumar::app {
@@ -26,8 +27,10 @@ struct CalibrateOptions {
   std::string coverage;
   calib::RobustCalibrationOptions calib;
   bool no_reject = false;
-  std::string video;  // --video FILE --every N instead of --images
+  std::string video;   // --video FILE: the same as --source video:FILE
+  std::string source;  // --source SPEC --every N instead of --images
   int every = 10;
+  int max_frames = 500;
   std::string charuco;  // --charuco SQUARESxSQUARES: a ChArUco board instead of a checkerboard
   double marker = 0.0;
   std::string dict = "DICT_5X5_100";
@@ -58,14 +61,25 @@ std::vector<std::filesystem::path> expand(const std::vector<std::string>& patter
   return out;
 }
 
+// Every Nth frame of --source; a live camera delivers until --max-views frames are taken.
+std::vector<calib::NamedImage> frames_from_source(const CalibrateOptions& o) {
+  capture::SourceOptions options;
+  options.fps = 30.0;  // an image sequence's timing does not matter here
+  auto opened = capture::open_frame_source(o.source, options);
+  if (opened.live)
+    spdlog::info("calibrate: taking every {}th frame of {} until {} views; move the board around the image",
+                 o.every, o.source, o.max_frames);
+  return calib::sample_frames(*opened.source, o.every, o.max_frames);
+}
+
 // ChArUco: cv::aruco::calibrateCameraCharuco on every view holding enough corners.
 void run_charuco(const CalibrateOptions& o) {
   const cv::Size squares = parse_board(o.charuco);
   if (!(o.marker > 0)) throw InputError("--charuco: give the marker side with --marker (metres)");
   const calib::CharucoBoardSpec spec{squares.width, squares.height, o.square, o.marker, o.dict};
   std::vector<calib::NamedImage> images;
-  if (!o.video.empty()) {
-    images = calib::sample_video_frames(o.video, o.every);
+  if (!o.source.empty()) {
+    images = frames_from_source(o);
   } else {
     for (const auto& path : expand(o.images)) {
       cv::Mat image = cv::imread(path.string(), cv::IMREAD_GRAYSCALE);
@@ -104,8 +118,12 @@ void register_calibrate(CLI::App& app) {
   auto o = std::make_shared<CalibrateOptions>();
   auto* cmd = app.add_subcommand("calibrate", "Calibrate camera intrinsics from checkerboard images");
   cmd->add_option("--images", o->images, "Image files or glob patterns (quote globs)");
-  cmd->add_option("--video", o->video, "A video file of the board instead of --images");
-  cmd->add_option("--every", o->every, "--video: use every Nth frame")->check(CLI::PositiveNumber)->capture_default_str();
+  cmd->add_option("--video", o->video, "A video file of the board instead of --images (as --source video:FILE)");
+  cmd->add_option("--source", o->source,
+                  "Frames instead of --images: video:FILE, images:GLOB, recording:DIR or a live camera v4l2:/dev/videoN");
+  cmd->add_option("--every", o->every, "--video/--source: use every Nth frame")->check(CLI::PositiveNumber)->capture_default_str();
+  cmd->add_option("--max-views", o->max_frames, "--video/--source: stop after this many sampled frames")
+      ->check(CLI::PositiveNumber)->capture_default_str();
   cmd->add_option("--charuco", o->charuco, "A ChArUco board of SQUARESxSQUARES (squares, not corners) instead of --board");
   cmd->add_option("--marker", o->marker, "--charuco: marker side in metres")->check(CLI::PositiveNumber);
   cmd->add_option("--dict", o->dict, "--charuco: ArUco dictionary")->capture_default_str();
@@ -118,16 +136,20 @@ void register_calibrate(CLI::App& app) {
   cmd->add_flag("--no-reject", o->no_reject, "Keep every view (no outlier rejection)");
   cmd->add_option("--coverage", o->coverage, "Write a PNG of where the corners fell on the sensor");
   add_action(cmd, [o] {
-    if (o->images.empty() == o->video.empty()) throw InputError("calibrate: give either --images or --video");
+    if (!o->video.empty()) {
+      if (!o->source.empty()) throw InputError("calibrate: give --video or --source, not both");
+      o->source = "video:" + o->video;
+    }
+    if (o->images.empty() == o->source.empty())
+      throw InputError("calibrate: give either --images or --source (or --video)");
     if (!o->charuco.empty()) {
       run_charuco(*o);
       return;
     }
     const cv::Size board = parse_board(o->board);
-    const auto views = o->video.empty()
+    const auto views = o->source.empty()
                            ? calib::detect_checkerboard_views(expand(o->images), board, o->square)
-                           : calib::detect_checkerboard_views(calib::sample_video_frames(o->video, o->every), board,
-                                                              o->square);
+                           : calib::detect_checkerboard_views(frames_from_source(*o), board, o->square);
     auto options = o->calib;
     options.reject_outliers = !o->no_reject;
     const auto result = calib::calibrate_robust(views, options);

@@ -10,16 +10,13 @@
 
 namespace lumar::calib {
 
-std::vector<NamedImage> sample_video_frames(const std::filesystem::path& video, int every, int max_frames) {
+std::vector<NamedImage> sample_frames(capture::FrameSource& source, int every, int max_frames) {
   if (every < 1) throw InputError("--every: must be 1 or more");
-  if (!std::filesystem::is_regular_file(video)) throw InputError(video.string() + ": video not found; check the path");
-  cv::VideoCapture capture(video.string());
-  if (!capture.isOpened()) throw InputError(video.string() + ": cannot decode this video; convert it to MJPEG or H.264");
   std::vector<NamedImage> out;
-  cv::Mat frame;
-  for (int k = 0; capture.read(frame) && int(out.size()) < max_frames; ++k)
-    if (k % every == 0) out.push_back({video.string() + "#" + std::to_string(k), frame.clone()});
-  if (out.empty()) throw InputError(video.string() + ": the video has no frames");
+  capture::Frame frame;
+  for (int k = 0; int(out.size()) < max_frames && source.read(frame); ++k)
+    if (k % every == 0) out.push_back({source.describe() + "#" + std::to_string(frame.index), frame.image.clone()});
+  if (out.empty()) throw InputError(source.describe() + ": delivered no frames");
   return out;
 }
 

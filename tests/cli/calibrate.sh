@@ -81,4 +81,18 @@ case_images_of_different_sizes() {
     "$LUMAR" calibrate --images "$BOARDS/left01.jpg" "$TMP/small.png" --out "$TMP/cam.yml"
 }
 
+case_frame_source_matches_images() {
+  # The same photographs through the frame-source path (as a live camera would deliver
+  # them, decoded to colour) give the same calibration as --images (read as grey) up to
+  # the rounding of the colour-to-grey conversion.
+  "$LUMAR" calibrate --images "$BOARDS/*.jpg" --out "$TMP/a.yml" --json >"$TMP/a.json" 2>"$TMP/stderr" ||
+    { cat "$TMP/stderr" >&2; fail "calibrate --images failed"; }
+  "$LUMAR" calibrate --source "images:$BOARDS/*.jpg" --every 1 --out "$TMP/b.yml" --json >"$TMP/out.json" 2>"$TMP/stderr" ||
+    { cat "$TMP/stderr" >&2; fail "calibrate --source failed"; }
+  json_check "j['views_used'] == 12 and len(j['views_rejected']) == 1"
+  python3 -c "import json; a=json.load(open('$TMP/a.json')); b=json.load(open('$TMP/out.json')); assert all(abs(a[k]-b[k]) <= 1e-5 * abs(a[k]) for k in ['rms','fx','fy','cx','cy']), (a['rms'], b['rms'])" ||
+    fail "--source gave a different calibration than --images"
+  expect_bad_input "nowhere" "$TMP/c.yml" -- "$LUMAR" calibrate --source "nowhere:x" --out "$TMP/c.yml"
+}
+
 run_case

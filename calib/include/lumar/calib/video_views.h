@@ -1,5 +1,6 @@
 #pragma once
-// Calibration views sampled from a video file (`lumar calibrate --video FILE --every N`).
+// Calibration views sampled from any frame source: a video file, an image sequence, a
+// recording or a live camera (`lumar calibrate --source SPEC --every N`).
 #include <filesystem>
 #include <opencv2/core.hpp>
 #include <string>
@@ -7,6 +8,7 @@
 #include <vector>
 
 #include "lumar/calib/checkerboard_calibration.h"
+#include "lumar/capture/frame_source.h"
 
 namespace lumar::calib {
 
@@ -15,9 +17,9 @@ struct NamedImage {
   cv::Mat image;
 };
 
-// Every `every`-th frame of the video (frame 0 first), at most max_frames. Throws
-// InputError when the file is missing, cannot be decoded, or `every` < 1.
-std::vector<NamedImage> sample_video_frames(const std::filesystem::path& video, int every, int max_frames = 500);
+// Every `every`-th frame the source delivers (frame 0 first), at most max_frames; named
+// "<source>#<frame index>". Throws InputError when `every` < 1 or no frame arrives.
+std::vector<NamedImage> sample_frames(capture::FrameSource& source, int every, int max_frames = 500);
 
 // detect_checkerboard_views for images already in memory (same checks and errors).
 CheckerboardViews detect_checkerboard_views(const std::vector<NamedImage>& images, cv::Size inner_corners,
