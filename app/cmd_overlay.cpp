@@ -16,6 +16,7 @@ struct OverlayOptions {
   std::string recording, scene, out, frames_dir, contact_sheet, poses = "tracker", undistort = "same";
   bool window = false;
   int max_frames = 0;
+  int adapt_lighting = 0;
 };
 }  // namespace
 
@@ -37,6 +38,9 @@ void register_overlay(CLI::App& app) {
   cmd->add_option("--undistort", o->undistort,
                   "Output camera: 'same' keeps the calibrated matrix, 'crop' shows only valid pixels, 'keep' every input pixel")
       ->check(CLI::IsMember({"same", "crop", "keep"}))->capture_default_str();
+  cmd->add_option("--adapt-lighting", o->adapt_lighting,
+                  "Every N frames, compare the video with the map and follow the room getting brighter or darker (0 = off)")
+      ->check(CLI::NonNegativeNumber)->capture_default_str();
   cmd->add_flag("--window", o->window, "Show the result in a window (needs a display)");
   cmd->add_option("--max-frames", o->max_frames, "Stop after this many frames (0 = all)")->capture_default_str();
   add_action(cmd, [o, live] {
@@ -55,7 +59,7 @@ void register_overlay(CLI::App& app) {
                               : o->undistort == "keep" ? calib::UndistortedCamera::KeepAll
                                                        : calib::UndistortedCamera::SameMatrix;
     ReplayOverlay overlay(o->recording, o->scene, o->poses == "truth" ? PoseSource::Truth : PoseSource::Tracker,
-                          o->window, undistortion);
+                          o->window, undistortion, o->adapt_lighting);
     const auto& camera = overlay.compositor().output_camera();
     const double fps = overlay.replay().reader().session().value("video", nlohmann::json::object()).value("fps", 30.0);
     std::optional<VideoOutput> video;
@@ -87,6 +91,9 @@ void register_overlay(CLI::App& app) {
     spdlog::info("overlay: {} frames{}{}; tracker: {} records, {} rejected, {} bytes skipped",
                  overlay.times().frames, o->out.empty() ? "" : " -> " + o->out,
                  video ? " (" + video->codec() + ")" : "", stats.records, stats.rejected_records, stats.skipped_bytes);
+    if (const auto* lighting = overlay.live_lighting())
+      spdlog::info("overlay: lighting scale {:.3f} after {} comparisons of the video with the map", lighting->scale(),
+                   lighting->measurements());
     if (overlay.frames_without_pose() > 0)
       spdlog::warn("overlay: {} frames had no tracker pose and show the video alone", overlay.frames_without_pose());
     spdlog::info("{}", format_stage_times(overlay.times()));

@@ -14,24 +14,27 @@ double ms_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 }
 
-// The session's response ("srgb" or a response JSON, relative to the recording) and vignetting.
+// The session's response: "srgb" or a response JSON, relative to the recording.
+std::optional<calib::CameraResponse> session_response(const capture::Radiometry& radiometry,
+                                                      const std::filesystem::path& recording) {
+  if (radiometry.response == "srgb") return std::nullopt;
+  return calib::load_camera_response(recording / radiometry.response);  // absolute paths stay absolute
+}
+
 gl::VideoRadiometry video_radiometry(const capture::Radiometry& radiometry, const CameraIntrinsics& camera,
-                                     const std::filesystem::path& recording) {
+                                     const std::optional<calib::CameraResponse>& response) {
   gl::VideoRadiometry out;
   out.video_camera = camera;
   out.vignetting_a = radiometry.vignetting_a;
   out.vignetting_b = radiometry.vignetting_b;
-  if (radiometry.response != "srgb") {
-    const std::filesystem::path file = recording / radiometry.response;  // absolute paths stay absolute
-    const calib::CameraResponse response = calib::load_camera_response(file);
-    out.linear_of_code.assign(response.exposure.begin(), response.exposure.end());
-  }
+  if (response) out.linear_of_code.assign(response->exposure.begin(), response->exposure.end());
   return out;
 }
 }  // namespace
 
 ReplayOverlay::ReplayOverlay(const std::filesystem::path& recording, const std::filesystem::path& scene_override,
-                             PoseSource poses, bool window, calib::UndistortedCamera undistortion)
+                             PoseSource poses, bool window, calib::UndistortedCamera undistortion,
+                             int adapt_lighting_every)
     : replay_(recording), pose_source_(poses) {
   const std::filesystem::path scene_path = scene_override.empty() ? replay_.scene_path() : scene_override;
   if (scene_path.empty())
@@ -50,7 +53,12 @@ ReplayOverlay::ReplayOverlay(const std::filesystem::path& recording, const std::
   }
   const calib::UndistortionMaps maps = calib::make_undistortion_maps(camera, undistortion);
   compositor_ = std::make_unique<Compositor>(scene_, maps.output, maps.map_x, maps.map_y);
-  compositor_->renderer().set_video_radiometry(video_radiometry(replay_.session().radiometry, camera, recording));
+  const auto& radiometry = replay_.session().radiometry;
+  const auto response = session_response(radiometry, recording);
+  compositor_->renderer().set_video_radiometry(video_radiometry(radiometry, camera, response));
+  if (adapt_lighting_every > 0)
+    live_lighting_.emplace(camera, maps, response.value_or(calib::srgb_response(1.0)), radiometry,
+                           adapt_lighting_every);
 }
 
 ReplayOverlay::~ReplayOverlay() {
@@ -78,7 +86,15 @@ void ReplayOverlay::run(int max_frames, const std::function<bool(const OverlayFr
 
     gl::OverlayTimings gt;
     if (!out.T_world_camera) ++frames_without_pose_;
-    out.composite = compositor_->composite(frame.image, out.T_world_camera, exposure, &gt);
+    double lighting_scale = 1.0;
+    if (live_lighting_ && out.T_world_camera) {
+      t0 = std::chrono::steady_clock::now();
+      lighting_scale = live_lighting_->update(compositor_->renderer(), frame.image, *out.T_world_camera, frame.time);
+      times_.lighting += ms_since(t0);
+    }
+    // The map's light scaled as the room changed: the objects' radiance scales with it.
+    out.composite = compositor_->composite(frame.image, out.T_world_camera, exposure * lighting_scale, &gt);
+    out.lighting_scale = lighting_scale;
     times_.upload += gt.upload_ms;
     times_.background += gt.background_ms;
     times_.depth += gt.depth_ms;
@@ -96,7 +112,8 @@ void ReplayOverlay::run(int max_frames, const std::function<bool(const OverlayFr
 std::string format_stage_times(const StageTimes& t) {
   const int n = std::max(1, t.frames);
   const std::pair<const char*, double> stages[] = {
-      {"decode video", t.decode},      {"tracker pose", t.pose},   {"upload frame", t.upload},
+      {"decode video", t.decode},      {"tracker pose", t.pose},   {"lighting adaptation", t.lighting},
+      {"upload frame", t.upload},
       {"background (undistort)", t.background}, {"proxy depth", t.depth}, {"virtual objects", t.objects},
       {"read back", t.readback},       {"encode output", t.output}};
   double total = 0;

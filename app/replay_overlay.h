@@ -6,6 +6,7 @@
 #include <memory>
 #include <optional>
 
+#include "live_lighting.h"
 #include "lumar/calib/undistortion.h"
 #include "lumar/capture/recording_replay.h"
 #include "lumar/core/compositor.h"
@@ -17,7 +18,7 @@ namespace lumar::app {
 enum class PoseSource { Tracker, Truth };
 
 struct StageTimes {  // milliseconds, summed over frames
-  double decode = 0, pose = 0, upload = 0, background = 0, depth = 0, objects = 0, readback = 0, output = 0;
+  double decode = 0, pose = 0, lighting = 0, upload = 0, background = 0, depth = 0, objects = 0, readback = 0, output = 0;
   int frames = 0;
 };
 
@@ -27,15 +28,19 @@ struct OverlayFrame {
   cv::Mat video;                  // as recorded
   cv::Mat composite;              // BGR8 output
   std::optional<Pose> T_world_camera;  // the pose used (nullopt: no pose, video only)
+  double lighting_scale = 1.0;         // the map's light as the room measured now (1: unchanged)
 };
 
 class ReplayOverlay {
  public:
   // `window`: a GLFW window to draw into; otherwise a headless EGL context is made.
   // `undistortion`: which undistorted camera the output uses (calib/undistortion.h).
+  // `adapt_lighting_every` > 0: compare the video with the map every that many frames and
+  // scale the objects' lighting as the room gets brighter or darker (live_lighting.h).
   ReplayOverlay(const std::filesystem::path& recording, const std::filesystem::path& scene_override,
                 PoseSource poses, bool window,
-                calib::UndistortedCamera undistortion = calib::UndistortedCamera::SameMatrix);
+                calib::UndistortedCamera undistortion = calib::UndistortedCamera::SameMatrix,
+                int adapt_lighting_every = 0);
   ~ReplayOverlay();
 
   // Runs every frame (up to max_frames, 0 = all) through the compositor; `sink` sees each
@@ -48,6 +53,7 @@ class ReplayOverlay {
   gl::WindowContext* window() { return window_; }
   const StageTimes& times() const { return times_; }
   int frames_without_pose() const { return frames_without_pose_; }
+  const LiveLighting* live_lighting() const { return live_lighting_ ? &*live_lighting_ : nullptr; }
 
  private:
   capture::RecordingReplay replay_;
@@ -58,6 +64,7 @@ class ReplayOverlay {
   std::unique_ptr<Compositor> compositor_;
   StageTimes times_;
   int frames_without_pose_ = 0;
+  std::optional<LiveLighting> live_lighting_;
 };
 
 // One line per stage: mean milliseconds per frame and share of the total.

@@ -72,37 +72,37 @@ case_undistortion_modes() {
     "$LUMAR" overlay --recording "$REC" --max-frames 1 --undistort $mode --frames-dir "$TMP/$mode" >"$TMP/log" 2>&1 ||
       { cat "$TMP/log"; fail "overlay --undistort $mode failed"; }
   done
-  # Share of black pixels on the ring one pixel inside the image border.
-  black_border() {
-    python3 -c "import struct,sys,zlib
-d=open(sys.argv[1],'rb').read(); i=8; idat=b''
-while i < len(d):
-    n,t=struct.unpack('>I4s',d[i:i+8]); c=d[i+8:i+8+n]; i+=12+n
-    if t==b'IHDR': w,h,bits,ct=struct.unpack('>IIBB',c[:10])
-    if t==b'IDAT': idat+=c
-raw=zlib.decompress(idat); bpp=3 if ct==2 else 4; stride=w*bpp
-rows=[]; prev=bytearray(stride)
-for y in range(h):
-    f=raw[y*(stride+1)]; line=bytearray(raw[y*(stride+1)+1:(y+1)*(stride+1)])
-    for x in range(stride):
-        a=line[x-bpp] if x>=bpp else 0; b=prev[x]; cc=prev[x-bpp] if x>=bpp else 0
-        if f==1: line[x]=(line[x]+a)&255
-        elif f==2: line[x]=(line[x]+b)&255
-        elif f==3: line[x]=(line[x]+(a+b)//2)&255
-        elif f==4:
-            p=a+b-cc; pa,pb,pc=abs(p-a),abs(p-b),abs(p-cc)
-            line[x]=(line[x]+(a if pa<=pb and pa<=pc else b if pb<=pc else cc))&255
-    rows.append(line); prev=line
-ring=[(1,x) for x in range(1,w-1)]+[(h-2,x) for x in range(1,w-1)]+[(y,1) for y in range(2,h-2)]+[(y,w-2) for y in range(2,h-2)]
-print('%.4f' % (sum(1 for y,x in ring if sum(rows[y][x*bpp:x*bpp+3])==0)/len(ring)))" "$1"
-  }
   local keep crop
-  keep=$(black_border "$TMP"/keep/*.png)
-  crop=$(black_border "$TMP"/crop/*.png)
+  keep=$(python3 "$(dirname "$0")/png_tool.py" black-border "$TMP"/keep/*.png)
+  crop=$(python3 "$(dirname "$0")/png_tool.py" black-border "$TMP"/crop/*.png)
   python3 -c "import sys; sys.exit(0 if $keep > 0.05 and $crop < 0.005 else 1)" ||
     fail "black border share: keep $keep (want > 0.05), crop $crop (want < 0.005)"
   cmp -s "$TMP"/same/*.png "$TMP"/crop/*.png && fail "crop gave the same image as same"
   echo "ok: black share of the border ring: keep $keep, crop $crop"
+}
+
+case_adapt_lighting_follows_the_room() {
+  # The same video, but the session claims twice the exposure: the room now looks half as
+  # bright as the map predicts. With --adapt-lighting the objects' light follows (scale
+  # ~0.5) and frames match those of the true session; without it the objects are too bright.
+  cp -r "$REC" "$TMP/rec"
+  local scene=$SRC/data/scenes/room/scene.json
+  "$LUMAR" overlay --recording "$TMP/rec" --scene "$scene" --max-frames 9 --adapt-lighting 4 \
+    --frames-dir "$TMP/true" >"$TMP/log" 2>&1 || { cat "$TMP/log"; fail "overlay failed"; }
+  python3 -c "import json; p='$TMP/rec/session.json'; j=json.load(open(p)); j['radiometry']['exposure'] *= 2; json.dump(j, open(p, 'w'))"
+  "$LUMAR" overlay --recording "$TMP/rec" --scene "$scene" --max-frames 9 --adapt-lighting 4 \
+    --frames-dir "$TMP/adapted" >"$TMP/log" 2>&1 || { cat "$TMP/log"; fail "overlay --adapt-lighting failed"; }
+  grep -o "lighting scale [0-9.]*" "$TMP/log" >"$TMP/scale" || { cat "$TMP/log"; fail "no lighting scale reported"; }
+  python3 -c "import sys; s=float(open('$TMP/scale').read().split()[-1]); sys.exit(0 if abs(s - 0.5) < 0.03 else 1)" ||
+    fail "lighting scale $(cat "$TMP/scale"), expected about 0.5"
+  "$LUMAR" overlay --recording "$TMP/rec" --scene "$scene" --max-frames 9 --frames-dir "$TMP/fixed" >"$TMP/log" 2>&1 ||
+    { cat "$TMP/log"; fail "overlay failed"; }
+  local adapted fixed
+  adapted=$(python3 "$(dirname "$0")/png_tool.py" mean-abs-diff "$TMP/true/frame-000008.png" "$TMP/adapted/frame-000008.png")
+  fixed=$(python3 "$(dirname "$0")/png_tool.py" mean-abs-diff "$TMP/true/frame-000008.png" "$TMP/fixed/frame-000008.png")
+  python3 -c "import sys; sys.exit(0 if $adapted < 0.25 * $fixed and $fixed > 0.05 else 1)" ||
+    fail "frame 8 differs from the true session's by $adapted levels adapted, $fixed without adapting"
+  echo "ok: $(cat "$TMP/scale"); frame 8 vs the true session: $adapted levels adapted, $fixed without"
 }
 
 case_help_describes_every_option() {
