@@ -6,7 +6,13 @@ SRC=$2
 SHARED=$3
 CASE=$4
 TMP=$(mktemp -d "${TMPDIR:-/tmp}/lumar-cli-XXXXXX")
-trap 'rm -rf "$TMP"' EXIT
+# Background processes a case starts go into PIDS: killed by process id at exit.
+PIDS=()
+cleanup() {
+  for pid in "${PIDS[@]}"; do kill -9 "$pid" 2>/dev/null; done
+  rm -rf "$TMP"
+}
+trap cleanup EXIT
 unset DISPLAY  # headless unless a case asks for a display
 
 fail() { echo "FAIL: $*" >&2; exit 1; }
@@ -31,6 +37,28 @@ expect_bad_input() {
     [ "$partials" -eq 0 ] || fail "a partial output was left behind in $(dirname "$output")"
   fi
   echo "ok: $(head -1 "$TMP/stderr")"
+}
+
+# wait_for SECONDS COMMAND...: true once COMMAND succeeds, false at the deadline.
+wait_for() {
+  local deadline=$((SECONDS + $1))
+  shift
+  until "$@"; do
+    [ $SECONDS -lt $deadline ] || return 1
+    sleep 0.05
+  done
+}
+
+# Complete lines of a file (a line cut short by a crash has no '\n' and does not count).
+complete_lines() { [ -f "$1" ] && tr -cd '\n' <"$1" | wc -c || echo 0; }
+at_least_lines() { [ "$(complete_lines "$1")" -ge "$2" ]; }
+
+# The tracker emulator on a pty at $TMP/tty, logging what it sent to $TMP/sent.csv.
+start_emulator() {  # extra emulator options...
+  "$LUMAR" tracker emulate --link "$TMP/tty" --sent-log "$TMP/sent.csv" "$@" >"$TMP/emulator.log" 2>&1 &
+  EMULATOR=$!
+  PIDS+=("$EMULATOR")
+  wait_for 5 test -L "$TMP/tty" || { cat "$TMP/emulator.log"; fail "the emulator made no link"; }
 }
 
 run_case() {

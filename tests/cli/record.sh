@@ -4,31 +4,7 @@
 # has a deadline.
 source "$(dirname "$0")/lib.sh"
 
-PIDS=()
-cleanup() {
-  for pid in "${PIDS[@]}"; do kill -9 "$pid" 2>/dev/null; done
-  rm -rf "$TMP"
-}
-trap cleanup EXIT
-
-wait_for() {
-  local deadline=$((SECONDS + $1))
-  shift
-  until "$@"; do
-    [ $SECONDS -lt $deadline ] || return 1
-    sleep 0.05
-  done
-}
-complete_lines() { [ -f "$1" ] && tr -cd '\n' <"$1" | wc -c || echo 0; }
-at_least_lines() { [ "$(complete_lines "$1")" -ge "$2" ]; }
 VTEST="$SHARED/data/video/vtest.avi"
-
-start_emulator() {
-  "$LUMAR" tracker emulate --link "$TMP/tty" --rate 60 >"$TMP/emulator.log" 2>&1 &
-  EMULATOR=$!
-  PIDS+=("$EMULATOR")
-  wait_for 5 test -L "$TMP/tty" || { cat "$TMP/emulator.log"; fail "the emulator made no link"; }
-}
 
 # Every frame frames.csv lists decodes: the overlay writes one PNG per frame.
 check_readable() {  # recording, expected frames
@@ -41,7 +17,7 @@ check_readable() {  # recording, expected frames
 }
 
 case_kill_9_keeps_all_but_the_last_second() {
-  start_emulator
+  start_emulator --rate 60
   "$LUMAR" record --source "video:$VTEST" --tracker "serial:$TMP/tty" --out "$TMP/rec" >"$TMP/record.log" 2>&1 &
   local recorder=$!
   PIDS+=("$recorder")
@@ -124,7 +100,7 @@ case_full_disk_stops_cleanly() {
 
 case_live_overlay_runs_in_a_window() {
   command -v xvfb-run >/dev/null || fail "xvfb-run is not installed"
-  start_emulator
+  start_emulator --rate 60
   xvfb-run -a -s "-screen 0 1024x768x24" "$LUMAR" overlay --source "video:$VTEST" --tracker "serial:$TMP/tty" \
     --scene "$SRC/data/scenes/room/scene.json" --max-frames 20 >"$TMP/out" 2>&1 || { cat "$TMP/out"; fail "live overlay failed"; }
   cat "$TMP/out"

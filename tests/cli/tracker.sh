@@ -3,34 +3,6 @@
 # deadline.
 source "$(dirname "$0")/lib.sh"
 
-PIDS=()
-cleanup() {
-  for pid in "${PIDS[@]}"; do kill -9 "$pid" 2>/dev/null; done
-  rm -rf "$TMP"
-}
-trap cleanup EXIT
-
-# wait_for SECONDS COMMAND...: true once COMMAND succeeds, false at the deadline.
-wait_for() {
-  local deadline=$((SECONDS + $1))
-  shift
-  until "$@"; do
-    [ $SECONDS -lt $deadline ] || return 1
-    sleep 0.05
-  done
-}
-
-# Complete lines of a file (a line cut short by a crash has no '\n' and does not count).
-complete_lines() { [ -f "$1" ] && tr -cd '\n' <"$1" | wc -c || echo 0; }
-at_least_lines() { [ "$(complete_lines "$1")" -ge "$2" ]; }
-
-start_emulator() {  # extra emulator options...
-  "$LUMAR" tracker emulate --link "$TMP/tty" --sent-log "$TMP/sent.csv" "$@" >"$TMP/emulator.log" 2>&1 &
-  EMULATOR=$!
-  PIDS+=("$EMULATOR")
-  wait_for 5 test -L "$TMP/tty" || { cat "$TMP/emulator.log"; fail "the emulator made no link"; }
-}
-
 stop_emulator() {
   kill -TERM "$EMULATOR"
   wait "$EMULATOR" || fail "the emulator did not exit cleanly on SIGTERM"

@@ -12,6 +12,7 @@
 #include <random>
 
 #include "lumar/core/latlong.h"
+#include "test_geometry.h"
 #include "test_paths.h"
 
 namespace lumar {
@@ -58,16 +59,7 @@ class BruteForceIrradiance {
   std::vector<glm::dvec3> directions_, weighted_;
 };
 
-std::vector<glm::dvec3> random_normals(int count, unsigned seed) {
-  std::mt19937 rng(seed);
-  std::normal_distribution<double> g;
-  std::vector<glm::dvec3> out;
-  while (int(out.size()) < count) {
-    const glm::dvec3 v(g(rng), g(rng), g(rng));
-    if (glm::length(v) > 1e-6) out.push_back(glm::normalize(v));
-  }
-  return out;
-}
+using test::random_normals;
 
 TEST(SphericalHarmonics, UniformMapGivesPi) {
   const EnvironmentMap map = map_from(128, [](const glm::dvec3&) { return 1.0; });

@@ -10,17 +10,6 @@
 
 namespace lumar::test {
 
-std::vector<glm::dvec3> random_normals(int count, unsigned seed) {
-  std::mt19937 rng(seed);
-  std::normal_distribution<double> g;
-  std::vector<glm::dvec3> out;
-  while (int(out.size()) < count) {
-    const glm::dvec3 v(g(rng), g(rng), g(rng));
-    if (glm::length(v) > 1e-6) out.push_back(glm::normalize(v));
-  }
-  return out;
-}
-
 ErrorStats luminance_errors(const std::vector<glm::dvec3>& value, const std::vector<glm::dvec3>& reference) {
   std::vector<double> e(value.size());
   ErrorStats s;

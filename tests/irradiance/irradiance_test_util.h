@@ -1,15 +1,14 @@
 #pragma once
-// Shared pieces of the irradiance tests: random normals, error statistics, the divided
+// Shared pieces of the irradiance tests: error statistics, the divided
 // proxy room with its synthetic window map (built in code, so the tests need no files).
 #include <glm/glm.hpp>
 #include <vector>
 
 #include "lumar/core/envmap.h"
 #include "lumar/core/mesh.h"
+#include "test_geometry.h"
 
 namespace lumar::test {
-
-std::vector<glm::dvec3> random_normals(int count, unsigned seed);
 
 struct ErrorStats {
   double mean = 0, p99 = 0, max = 0;

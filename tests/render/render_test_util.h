@@ -1,6 +1,6 @@
 #pragma once
 // Shared pieces of the renderer tests: one headless context per process, camera poses
-// (meshes built in code are in test_meshes.h).
+// (meshes built in code are in test_geometry.h).
 #include <opencv2/core.hpp>
 
 #include "lumar/core/camera.h"
@@ -8,7 +8,7 @@
 #include "lumar/core/mesh.h"
 #include "lumar/core/pose.h"
 #include "lumar/core/sh.h"
-#include "test_meshes.h"
+#include "test_geometry.h"
 
 namespace lumar::test {
 

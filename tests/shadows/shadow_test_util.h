@@ -7,7 +7,7 @@
 
 #include "lumar/core/envmap.h"
 #include "lumar/core/mesh.h"
-#include "test_meshes.h"
+#include "test_geometry.h"
 
 namespace lumar::test {
 

@@ -79,6 +79,13 @@ GlName create_buffer(const void* data, std::size_t bytes) {
   return buffer;
 }
 
+void attach_vec3_attribute(GLuint vertex_array, GLuint attribute, GLuint buffer) {
+  glVertexArrayVertexBuffer(vertex_array, attribute, buffer, 0, sizeof(float) * 3);
+  glVertexArrayAttribFormat(vertex_array, attribute, 3, GL_FLOAT, GL_FALSE, 0);
+  glVertexArrayAttribBinding(vertex_array, attribute, attribute);
+  glEnableVertexArrayAttrib(vertex_array, attribute);
+}
+
 GlName create_framebuffer() {
   GLuint id = 0;
   glCreateFramebuffers(1, &id);

@@ -21,16 +21,10 @@ GpuMesh::GpuMesh(const Mesh& mesh, const char* what) {
   vertex_array_ = create_vertex_array();
   const GLuint vao = vertex_array_.get();
   positions_ = create_buffer(mesh.positions.data(), mesh.positions.size() * sizeof(glm::vec3));
-  glVertexArrayVertexBuffer(vao, 0, positions_.get(), 0, sizeof(glm::vec3));
-  glVertexArrayAttribFormat(vao, 0, 3, GL_FLOAT, GL_FALSE, 0);
-  glVertexArrayAttribBinding(vao, 0, 0);
-  glEnableVertexArrayAttrib(vao, 0);
+  attach_vec3_attribute(vao, 0, positions_.get());
   if (!mesh.normals.empty()) {
     normals_ = create_buffer(mesh.normals.data(), mesh.normals.size() * sizeof(glm::vec3));
-    glVertexArrayVertexBuffer(vao, 1, normals_.get(), 0, sizeof(glm::vec3));
-    glVertexArrayAttribFormat(vao, 1, 3, GL_FLOAT, GL_FALSE, 0);
-    glVertexArrayAttribBinding(vao, 1, 1);
-    glEnableVertexArrayAttrib(vao, 1);
+    attach_vec3_attribute(vao, 1, normals_.get());
   }
   indices_ = create_buffer(mesh.indices.data(), mesh.indices.size() * sizeof(std::uint32_t));
   glVertexArrayElementBuffer(vao, indices_.get());

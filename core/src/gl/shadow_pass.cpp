@@ -54,16 +54,10 @@ void ShadowPass::set_receivers(const Mesh& mesh) {
   vertex_array_ = create_vertex_array();
   const GLuint vao = vertex_array_.get();
   positions_ = create_buffer(mesh.positions.data(), mesh.positions.size() * sizeof(glm::vec3));
-  glVertexArrayVertexBuffer(vao, 0, positions_.get(), 0, sizeof(glm::vec3));
-  glVertexArrayAttribFormat(vao, 0, 3, GL_FLOAT, GL_FALSE, 0);
-  glVertexArrayAttribBinding(vao, 0, 0);
-  glEnableVertexArrayAttrib(vao, 0);
+  attach_vec3_attribute(vao, 0, positions_.get());
   const std::vector<glm::vec3> ones(mesh.positions.size(), glm::vec3(1.0f));
   attenuation_ = dynamic_buffer(ones.data(), ones.size() * sizeof(glm::vec3));
-  glVertexArrayVertexBuffer(vao, 2, attenuation_.get(), 0, sizeof(glm::vec3));
-  glVertexArrayAttribFormat(vao, 2, 3, GL_FLOAT, GL_FALSE, 0);
-  glVertexArrayAttribBinding(vao, 2, 2);
-  glEnableVertexArrayAttrib(vao, 2);
+  attach_vec3_attribute(vao, 2, attenuation_.get());
   indices_ = create_buffer(mesh.indices.data(), mesh.indices.size() * sizeof(std::uint32_t));
   glVertexArrayElementBuffer(vao, indices_.get());
   index_count_ = GLsizei(mesh.indices.size());

@@ -1,7 +1,8 @@
-#include "test_meshes.h"
+#include "test_geometry.h"
 
 #include <cmath>
 #include <numbers>
+#include <random>
 
 namespace lumar::test {
 
@@ -58,6 +59,17 @@ Mesh make_quad(const glm::vec3& centre, const glm::vec3& a, const glm::vec3& b, 
   m.normals.assign(4, glm::normalize(normal));
   m.indices = {0, 1, 2, 0, 2, 3};
   return m;
+}
+
+std::vector<glm::dvec3> random_normals(int count, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> g;
+  std::vector<glm::dvec3> out;
+  while (int(out.size()) < count) {
+    const glm::dvec3 v(g(rng), g(rng), g(rng));
+    if (glm::length(v) > 1e-6) out.push_back(glm::normalize(v));
+  }
+  return out;
 }
 
 }  // namespace lumar::test

@@ -1,6 +1,7 @@
 #pragma once
-// Meshes built in code, so that tests need no model files.
+// Meshes and directions built in code, so that tests need no model files.
 #include <glm/glm.hpp>
+#include <vector>
 
 #include "lumar/core/mesh.h"
 
@@ -13,5 +14,8 @@ Mesh make_box(const glm::vec3& min, const glm::vec3& max, bool inward = false);
 // A rectangle through `centre` spanned by half-extents `a` and `b`; all four vertex
 // normals are `normal` (need not match the geometry: the shading tests choose it freely).
 Mesh make_quad(const glm::vec3& centre, const glm::vec3& a, const glm::vec3& b, const glm::vec3& normal);
+
+// `count` unit vectors uniformly distributed over the sphere (normalised Gaussians).
+std::vector<glm::dvec3> random_normals(int count, unsigned seed);
 
 }  // namespace lumar::test
