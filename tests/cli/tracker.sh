@@ -50,8 +50,12 @@ case_record_survives_kill_9() {
   first=$(sed -n 2p "$TMP/raw.csv")
   start=$(grep -n -x -F -- "$first" "$TMP/sent.csv" | head -1 | cut -d: -f1)
   [ -n "$start" ] || fail "the first recorded record was never sent"
-  tail -n +"$start" "$TMP/sent.csv" | head -n "$records" | diff -q - <(tail -n +2 "$TMP/raw.csv") >/dev/null ||
+  # sed rather than tail | head: under pipefail, head closing early can kill tail with SIGPIPE.
+  sed -n "${start},$((start + records - 1))p" "$TMP/sent.csv" | diff - <(tail -n +2 "$TMP/raw.csv") >"$TMP/run.diff" || {
+    head -n 20 "$TMP/run.diff"
+    cat "$TMP/emulator.log" "$TMP/record.log"
     fail "tracker.raw is not the unbroken run of records the emulator sent"
+  }
   # poses.csv holds the same poses (full precision there, 6 decimals in the decode).
   paste -d, <(head -n $((poses + 1)) "$TMP/rec/poses.csv" | tail -n +2 | cut -d, -f2-) \
     <(tail -n +2 "$TMP/raw.csv" | head -n "$poses") |
