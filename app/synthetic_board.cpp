@@ -203,31 +203,17 @@ void synthesize_board_recording(const BoardSynthSettings& s) {
   const auto tracker = simulate_session_tracker(session, truth.latency, s.tracker_noise_deg, s.position_noise_m, s.seed,
                                                 [&](Nanos t) { return truth.sensor_pose(true_camera(t)); }, duration);
 
-  capture::RecordingSettings rs;
-  rs.codec = s.codec;
-  rs.fps = s.fps;
-  rs.size = cv::Size(s.camera.width, s.camera.height);
-  try {
-    capture::RecordingWriter writer(s.out, capture::session_to_json(session), rs);
-    write_tracker_stream(writer, tracker, session.tracker, session.rig.latency);
-    cv::RNG rng(s.seed);
-    cv::Mat noise(rs.size, CV_32F), grey, bgr;
-    for (int k = 0; k < frames; ++k) {
-      const Nanos t = start + frame_period * k;
-      const Pose T_world_camera = true_camera(t);
-      render_board_image(s.camera, s.board, s.square, T_world_camera.inverse() * T_world_board).convertTo(grey, CV_32F);
-      rng.fill(noise, cv::RNG::NORMAL, 0.0, s.image_noise);
-      cv::Mat(grey + noise).convertTo(grey, CV_8U);  // rounds and clips
-      cv::cvtColor(grey, bgr, cv::COLOR_GRAY2BGR);
-      writer.add_frame(capture::Frame{bgr, t, k});
-      writer.add_truth(k, t, T_world_camera);
-    }
-    writer.close();
-  } catch (...) {
-    std::error_code ec;
-    std::filesystem::remove_all(s.out, ec);
-    throw;
-  }
+  const capture::RecordingSettings video{.codec = s.codec, .fps = s.fps, .size = cv::Size(s.camera.width, s.camera.height)};
+  cv::Mat noise(video.size, CV_32F), grey, bgr;
+  write_synthetic_recording(
+      s.out, session, tracker, video, frames, s.seed, [&](int k) { return start + frame_period * k; }, true_camera,
+      [&](int, Nanos, const Pose& T_world_camera, cv::RNG& rng) {
+        render_board_image(s.camera, s.board, s.square, T_world_camera.inverse() * T_world_board).convertTo(grey, CV_32F);
+        rng.fill(noise, cv::RNG::NORMAL, 0.0, s.image_noise);
+        cv::Mat(grey + noise).convertTo(grey, CV_8U);  // rounds and clips
+        cv::cvtColor(grey, bgr, cv::COLOR_GRAY2BGR);
+        return bgr.clone();
+      });
   spdlog::info("synth: wrote {} ({} frames of a {}x{} board, tracker {} records, latency {} ms, assumed {} ms)",
                s.out.string(), frames, s.board.width, s.board.height, tracker.noisy_samples.size(), s.latency_ms,
                s.assumed_latency_ms);

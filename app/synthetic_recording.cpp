@@ -64,6 +64,29 @@ void write_tracker_stream(capture::RecordingWriter& writer, const tracking::Simu
   }
 }
 
+void write_synthetic_recording(const std::filesystem::path& out, const capture::Session& session,
+                               const tracking::SimulatedTrackerOutput& tracker, const capture::RecordingSettings& video,
+                               int frames, std::uint64_t seed, const std::function<Nanos(int)>& frame_time,
+                               const std::function<Pose(Nanos)>& true_camera, const SyntheticFrameRenderer& render) {
+  try {
+    capture::RecordingWriter writer(out, capture::session_to_json(session), video);
+    write_tracker_stream(writer, tracker, session.tracker, session.rig.latency);
+    cv::RNG rng(seed);
+    for (int k = 0; k < frames; ++k) {
+      const Nanos t = frame_time(k);
+      const Pose T_world_camera = true_camera(t);
+      writer.add_frame(capture::Frame{render(k, t, T_world_camera, rng), t, k});
+      writer.add_truth(k, t, T_world_camera);
+      if ((k + 1) % std::max(1, frames / 4) == 0 || k + 1 == frames) spdlog::info("synth: frame {}/{}", k + 1, frames);
+    }
+    writer.close();
+  } catch (...) {
+    std::error_code ec;
+    std::filesystem::remove_all(out, ec);
+    throw;
+  }
+}
+
 namespace {
 
 // A pinhole camera, `supersample` times finer than `camera`, wide enough to cover
@@ -191,31 +214,14 @@ void synthesize_recording(const SynthSettings& s) {
   session.radiometry.vignetting_a = s.vignetting_a;
   session.radiometry.vignetting_b = s.vignetting_b;
 
-  capture::RecordingSettings rs;
-  rs.codec = s.codec;
-  rs.quality = s.quality;
-  rs.fps = s.fps;
-  rs.size = cv::Size(s.camera.width, s.camera.height);
-  try {
-    capture::RecordingWriter writer(s.out, capture::session_to_json(session), rs);
-    write_tracker_stream(writer, tracker, session.tracker, session.rig.latency);
-    cv::RNG rng(s.seed);
-    for (int k = 0; k < s.frames; ++k) {
-      const Nanos t = start + frame_period * k;
-      const Pose T_world_camera = true_camera(t);
-      const cv::Mat radiance = renderer.render_room_radiance(pinhole, T_world_camera);
-      const cv::Mat distorted = calib::distort_image(radiance, pinhole, s.camera);
-      capture::Frame frame{expose(distorted, s.camera, s, exposure, rng), t, k};
-      writer.add_frame(frame);
-      writer.add_truth(k, t, T_world_camera);
-      if ((k + 1) % 12 == 0 || k + 1 == s.frames) spdlog::info("synth: frame {}/{}", k + 1, s.frames);
-    }
-    writer.close();
-  } catch (...) {
-    std::error_code ec;
-    std::filesystem::remove_all(s.out, ec);
-    throw;
-  }
+  const capture::RecordingSettings video{
+      .codec = s.codec, .quality = s.quality, .fps = s.fps, .size = cv::Size(s.camera.width, s.camera.height)};
+  write_synthetic_recording(
+      s.out, session, tracker, video, s.frames, s.seed, [&](int k) { return start + frame_period * k; }, true_camera,
+      [&](int, Nanos, const Pose& T_world_camera, cv::RNG& rng) {
+        const cv::Mat radiance = renderer.render_room_radiance(pinhole, T_world_camera);
+        return expose(calib::distort_image(radiance, pinhole, s.camera), s.camera, s, exposure, rng);
+      });
   spdlog::info("synth: wrote {} ({} frames, exposure {:.4g}, tracker {} records)", s.out.string(), s.frames,
                exposure, tracker.noisy_samples.size());
 }

@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <functional>
+#include <opencv2/core.hpp>
 #include <string>
 
 #include "lumar/capture/recording_writer.h"
@@ -52,6 +53,18 @@ tracking::SimulatedTrackerOutput simulate_session_tracker(const capture::Session
 // latency the recorder believed in, which need not be the simulated device's.
 void write_tracker_stream(capture::RecordingWriter& writer, const tracking::SimulatedTrackerOutput& tracker,
                           const capture::TrackerSettings& settings, Nanos assumed_latency);
+
+// One synthetic frame: the image the camera makes of the truth at frame k, time t.
+using SyntheticFrameRenderer = std::function<cv::Mat(int k, Nanos t, const Pose& T_world_camera, cv::RNG& rng)>;
+
+// Writes a synthetic recording into `out` (which must not exist yet): session.json, the
+// simulated tracker's stream, and `frames` frames at `frame_time(k)` seen from
+// `true_camera(t)`, drawn by `render` with one noise generator seeded by `seed`. On any
+// failure the partial directory is removed and the error rethrown.
+void write_synthetic_recording(const std::filesystem::path& out, const capture::Session& session,
+                               const tracking::SimulatedTrackerOutput& tracker, const capture::RecordingSettings& video,
+                               int frames, std::uint64_t seed, const std::function<Nanos(int)>& frame_time,
+                               const std::function<Pose(Nanos)>& true_camera, const SyntheticFrameRenderer& render);
 
 // The camera's true pose at s in [0, 1] along the orbit around `target`.
 Pose orbit_camera_pose(const glm::dvec3& target, double s, double arc_deg);

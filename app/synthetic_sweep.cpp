@@ -146,30 +146,14 @@ void synthesize_sweep(const SynthSettings& s, const SweepSynthSettings& sw) {
   sensor.vignetting_b = s.vignetting_b;
   const calib::EnvmapViewRenderer view(s.camera, s.supersample);
 
-  capture::RecordingSettings rs;
-  rs.codec = s.codec;
-  rs.quality = s.quality;
-  rs.fps = s.fps;
-  rs.size = cv::Size(s.camera.width, s.camera.height);
-  try {
-    capture::RecordingWriter writer(s.out, capture::session_to_json(session), rs);
-    write_tracker_stream(writer, tracker, session.tracker, session.rig.latency);
-    cv::RNG rng(s.seed);
-    for (int k = 0; k < s.frames; ++k) {
-      const Nanos t = timing.frame_time(k);
-      const Pose T_world_camera = true_camera(t);
-      const double exposure = exposures[std::size_t(k) % exposures.size()];
-      const cv::Mat radiance = view.render(map, T_world_camera.rotation);
-      writer.add_frame(capture::Frame{calib::expose_8bit(radiance, s.camera, sensor, exposure, rng), t, k});
-      writer.add_truth(k, t, T_world_camera);
-      if ((k + 1) % 24 == 0 || k + 1 == s.frames) spdlog::info("synth: sweep frame {}/{}", k + 1, s.frames);
-    }
-    writer.close();
-  } catch (...) {
-    std::error_code ec;
-    std::filesystem::remove_all(s.out, ec);
-    throw;
-  }
+  const capture::RecordingSettings video{
+      .codec = s.codec, .quality = s.quality, .fps = s.fps, .size = cv::Size(s.camera.width, s.camera.height)};
+  write_synthetic_recording(
+      s.out, session, tracker, video, s.frames, s.seed, [&](int k) { return timing.frame_time(k); }, true_camera,
+      [&](int k, Nanos, const Pose& T_world_camera, cv::RNG& rng) {
+        const double exposure = exposures[std::size_t(k) % exposures.size()];
+        return calib::expose_8bit(view.render(map, T_world_camera.rotation), s.camera, sensor, exposure, rng);
+      });
   spdlog::info("synth: wrote {} ({} frames, {} exposures, {} mode)", s.out.string(), s.frames, exposures.size(),
                sw.exposure_mode);
 }

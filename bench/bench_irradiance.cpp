@@ -12,6 +12,7 @@
 #include <random>
 
 #include "bench_report.h"
+#include "test_geometry.h"
 #include "lumar/core/irradiance_reference.h"
 #include "lumar/core/irradiance_scene.h"
 #include "lumar/core/irradiance_volume.h"
@@ -44,17 +45,6 @@ std::vector<Config> configs() {
   return out;
 }
 
-std::vector<glm::dvec3> random_normals(int count, unsigned seed) {
-  std::mt19937 rng(seed);
-  std::normal_distribution<double> g;
-  std::vector<glm::dvec3> out;
-  while (int(out.size()) < count) {
-    const glm::dvec3 v(g(rng), g(rng), g(rng));
-    if (glm::length(v) > 1e-6) out.push_back(glm::normalize(v));
-  }
-  return out;
-}
-
 double mean_error_percent(const std::vector<glm::dvec3>& a, const std::vector<glm::dvec3>& ref) {
   double sum = 0.0;
   for (std::size_t i = 0; i < a.size(); ++i)
@@ -71,7 +61,7 @@ int main() {
   // Room: reference points.
   const auto reference_room = scene_radiance(scene, reference_radiance_settings());
   std::mt19937 rng(17);
-  std::vector<glm::dvec3> points, normals = random_normals(60, 5);
+  std::vector<glm::dvec3> points, normals = lumar::test::random_normals(60, 5);
   for (int i = 0; i < 60; ++i) {
     glm::dvec3 p;
     for (int a = 0; a < 3; ++a)
@@ -116,7 +106,7 @@ int main() {
   bench::BenchReport distant = report("irradiance_distant", "Distant maps: error vs build time",
                                       "mean relative irradiance error vs texel sum, 4 maps (%)");
   distant.highlight = room.highlight;
-  const std::vector<glm::dvec3> dn = random_normals(500, 9);
+  const std::vector<glm::dvec3> dn = lumar::test::random_normals(500, 9);
   std::vector<EnvironmentMap> maps;
   std::vector<std::vector<glm::dvec3>> refs;
   for (const char* name : {"city", "courtyard", "interior", "studio"}) {

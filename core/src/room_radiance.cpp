@@ -13,7 +13,22 @@ namespace lumar {
 
 namespace {
 constexpr double kPi = std::numbers::pi;
+
+// Where the map's texels along `t.direction` came from: the proxy point the capture point
+// sees that way (a BrightTexel or a DominantLight). Left at infinity if the ray escapes.
+template <class Seen>
+void place_on_proxy(const RayScene* rays, const glm::dvec3& capture_position, Seen& t) {
+  if (!rays) return;
+  Ray ray;
+  ray.origin = glm::vec3(capture_position);
+  ray.direction = glm::vec3(t.direction);
+  if (const auto hit = rays->intersect(ray)) {
+    t.on_proxy = true;
+    t.position = capture_position + t.direction * double(hit->t);
+    t.normal = glm::dvec3(hit->normal);
+  }
 }
+}  // namespace
 
 EnvironmentMap downsample_environment_map(const EnvironmentMap& map, int height) {
   if (height <= 0 || height >= map.height || map.height % height != 0) return map;
@@ -97,16 +112,7 @@ void RoomRadiance::prepare(const EnvironmentMap& loaded) {
     t.radiance = glm::dvec3(map_.texel(c, r));
     t.solid_angle = omega[i];
     t.direction = glm::normalize(map_.world_direction(latlong_pixel_direction(c, r, W, H)));
-    if (rays_) {
-      Ray ray;
-      ray.origin = glm::vec3(map_.capture_position);
-      ray.direction = glm::vec3(t.direction);
-      if (const auto hit = rays_->intersect(ray)) {
-        t.on_proxy = true;
-        t.position = map_.capture_position + t.direction * double(hit->t);
-        t.normal = glm::dvec3(hit->normal);
-      }
-    }
+    place_on_proxy(rays_.get(), map_.capture_position, t);
     bright_index_[i] = int(bright_.size());
     bright_.push_back(t);
   }
@@ -201,16 +207,7 @@ void RoomRadiance::prepare(const EnvironmentMap& loaded) {
   if (int(candidates.size()) > settings_.max_lights) candidates.resize(std::size_t(std::max(0, settings_.max_lights)));
   for (int k : candidates) {
     DominantLight light = std::move(clusters[std::size_t(k)]);
-    if (rays_) {
-      Ray ray;
-      ray.origin = glm::vec3(map_.capture_position);
-      ray.direction = glm::vec3(light.direction);
-      if (const auto hit = rays_->intersect(ray)) {
-        light.on_proxy = true;
-        light.position = map_.capture_position + light.direction * double(hit->t);
-        light.normal = glm::dvec3(hit->normal);
-      }
-    }
+    place_on_proxy(rays_.get(), map_.capture_position, light);
     for (int t : light.texels) bright_[std::size_t(t)].light = int(lights_.size());
     lights_.push_back(std::move(light));
   }
