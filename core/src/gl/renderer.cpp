@@ -388,7 +388,16 @@ cv::Mat Renderer::render_overlay(const cv::Mat& video_bgr8, const std::optional<
     if (r.receivers) r.receivers->draw(vp);  // shadows on the video, before the objects
     clock.mark(&t.depth_ms);
 
+    // Depth first, then shade only the nearest surface: the per-pixel lighting is the
+    // costly part, and a figurine's own overlapping parts would otherwise pay it twice.
+    glColorMask(GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
+    r.draw_objects(r.depth_only.get(), vp, false, 0.0f);
+    glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+    glDepthFunc(GL_LEQUAL);
+    glDepthMask(GL_FALSE);
     r.draw_objects(r.shaded_object.get(), vp, true, float(exposure));
+    glDepthMask(GL_TRUE);
+    glDepthFunc(GL_LESS);
     glDisable(GL_DEPTH_TEST);
     clock.mark(&t.objects_ms);
   }

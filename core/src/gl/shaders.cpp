@@ -20,6 +20,8 @@ uniform mat3 normal_matrix;
 uniform mat4 view_projection;
 out vec3 world_position;
 out vec3 world_normal;
+// The objects' depth pre-pass and their shaded pass must agree to the bit (GL_LEQUAL).
+invariant gl_Position;
 void main() {
   vec4 w = model * vec4(position, 1.0);
   world_position = w.xyz;
