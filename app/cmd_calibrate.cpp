@@ -1,15 +1,15 @@
-// lumar calibrate: camera intrinsics from checkerboard images.
+// lumar calibrate: camera intrinsics from views of a checkerboard or a ChArUco board.
 #include <algorithm>
 #include <cstdio>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <opencv2/core/utility.hpp>
-#include <opencv2/imgcodecs.hpp>
 #include <spdlog/spdlog.h>
 
 #include "commands.h"
 #include "lumar/calib/calibration_report.h"
 #include "lumar/calib/charuco_calibration.h"
+#include "lumar/calib/checkerboard_calibration.h"
 #include "lumar/calib/video_views.h"
 #include "lumar/capture/source_spec.h"
 #include "lumar/core/error.h"
@@ -36,11 +36,11 @@ struct CalibrateOptions {
   std::string dict = "DICT_5X5_100";
 };
 
-cv::Size parse_board(const std::string& text) {
+cv::Size parse_board(const std::string& option, const std::string& text, const char* what) {
   int w = 0, h = 0;
   char x = 0, extra = 0;
   if (std::sscanf(text.c_str(), "%d%c%d%c", &w, &x, &h, &extra) != 3 || (x != 'x' && x != 'X') || w < 2 || h < 2)
-    throw InputError("--board " + text + ": expected inner corners as WxH, e.g. 9x6");
+    throw InputError(option + " " + text + ": expected " + what);
   return {w, h};
 }
 
@@ -72,51 +72,11 @@ std::vector<calib::NamedImage> frames_from_source(const CalibrateOptions& o) {
   return calib::sample_frames(*opened.source, o.every, o.max_frames);
 }
 
-// ChArUco: cv::aruco::calibrateCameraCharuco on every view holding enough corners.
-void run_charuco(const CalibrateOptions& o) {
-  const cv::Size squares = parse_board(o.charuco);
-  if (!(o.marker > 0)) throw InputError("--charuco: give the marker side with --marker (metres)");
-  const calib::CharucoBoardSpec spec{squares.width, squares.height, o.square, o.marker, o.dict};
-  std::vector<calib::NamedImage> images;
-  if (!o.source.empty()) {
-    images = frames_from_source(o);
-  } else {
-    for (const auto& path : expand(o.images)) {
-      cv::Mat image = cv::imread(path.string(), cv::IMREAD_GRAYSCALE);
-      if (image.empty()) throw InputError(path.string() + ": cannot read image; check the path or remove it");
-      images.push_back({path.string(), image});
-    }
-  }
-  std::vector<cv::Mat> mats;
-  for (const auto& i : images) mats.push_back(i.image);
-  const auto result = calib::calibrate_charuco(mats, spec);
-  calib::save_camera_file(o.out, result.camera);
-  const auto& c = result.camera.intrinsics;
-  if (o.json) {
-    nlohmann::json std_dev = nlohmann::json::object();
-    for (std::size_t i = 0; i < calib::kIntrinsicNames.size(); ++i) std_dev[calib::kIntrinsicNames[i]] = result.std_dev[i];
-    nlohmann::json used = nlohmann::json::array();
-    for (int i : result.used_views) used.push_back(images[std::size_t(i)].name);
-    std::printf("%s\n", nlohmann::json({{"rms", result.camera.avg_reprojection_error}, {"fx", c.fx}, {"fy", c.fy},
-                                        {"cx", c.cx}, {"cy", c.cy}, {"dist", c.distortion}, {"std", std_dev},
-                                        {"views_used", result.used_views.size()}, {"used_views", used},
-                                        {"views_rejected", nlohmann::json::array()},
-                                        {"per_view_rms", result.per_view_rms}})
-                               .dump(2)
-                               .c_str());
-  } else {
-    spdlog::info("calibrate: ChArUco board in {} of {} views; RMS {:.3f} px -> {}", result.used_views.size(),
-                 images.size(), result.camera.avg_reprojection_error, o.out);
-    spdlog::info("  fx {:.2f} ± {:.2f}  fy {:.2f} ± {:.2f}  cx {:.2f} ± {:.2f}  cy {:.2f} ± {:.2f}", c.fx,
-                 result.std_dev[0], c.fy, result.std_dev[1], c.cx, result.std_dev[2], c.cy, result.std_dev[3]);
-  }
-}
-
 }  // namespace
 
 void register_calibrate(CLI::App& app) {
   auto o = std::make_shared<CalibrateOptions>();
-  auto* cmd = app.add_subcommand("calibrate", "Calibrate camera intrinsics from checkerboard images");
+  auto* cmd = app.add_subcommand("calibrate", "Calibrate camera intrinsics from views of a checkerboard or ChArUco board");
   cmd->add_option("--images", o->images, "Image files or glob patterns (quote globs)");
   cmd->add_option("--video", o->video, "A video file of the board instead of --images (as --source video:FILE)");
   cmd->add_option("--source", o->source,
@@ -142,14 +102,20 @@ void register_calibrate(CLI::App& app) {
     }
     if (o->images.empty() == o->source.empty())
       throw InputError("calibrate: give either --images or --source (or --video)");
+    const std::vector<calib::NamedImage> images =
+        o->source.empty() ? calib::load_board_images(expand(o->images)) : frames_from_source(*o);
+    // Both boards give views for the same robust solve; the report names inner corners.
+    calib::BoardViews views;
+    cv::Size board;
     if (!o->charuco.empty()) {
-      run_charuco(*o);
-      return;
+      const cv::Size squares = parse_board("--charuco", o->charuco, "squares as WxH, e.g. 7x5");
+      if (!(o->marker > 0)) throw InputError("--charuco: give the marker side with --marker (metres)");
+      views = calib::detect_charuco_views(images, {squares.width, squares.height, o->square, o->marker, o->dict});
+      board = {squares.width - 1, squares.height - 1};
+    } else {
+      board = parse_board("--board", o->board, "inner corners as WxH, e.g. 9x6");
+      views = calib::detect_checkerboard_views(images, board, o->square);
     }
-    const cv::Size board = parse_board(o->board);
-    const auto views = o->source.empty()
-                           ? calib::detect_checkerboard_views(expand(o->images), board, o->square)
-                           : calib::detect_checkerboard_views(frames_from_source(*o), board, o->square);
     auto options = o->calib;
     options.reject_outliers = !o->no_reject;
     const auto result = calib::calibrate_robust(views, options);

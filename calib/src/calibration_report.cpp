@@ -62,7 +62,7 @@ void save_calibration_report(const std::filesystem::path& path, const RobustCali
   rename_into_place(tmp, path, "calibration file");
 }
 
-void write_coverage_image(const std::filesystem::path& path, const CheckerboardViews& views,
+void write_coverage_image(const std::filesystem::path& path, const BoardViews& views,
                           const RobustCalibrationResult& r, const RobustCalibrationOptions& o) {
   const cv::Size size = views.image_size;
   cv::Mat img(size, CV_8UC3, cv::Scalar(40, 40, 40));

@@ -69,38 +69,30 @@ std::optional<CharucoCorners> detect_charuco(const cv::Mat& image, const Charuco
   return out;
 }
 
-CharucoCalibration calibrate_charuco(const std::vector<cv::Mat>& images, const CharucoBoardSpec& spec, int flags) {
+BoardViews detect_charuco_views(const std::vector<NamedImage>& images, const CharucoBoardSpec& spec) {
   const auto board = make_board(spec);
-  std::vector<std::vector<cv::Point2f>> corners;
-  std::vector<std::vector<int>> ids;
-  CharucoCalibration out;
-  cv::Size size;
-  for (std::size_t i = 0; i < images.size(); ++i) {
-    if (size.empty()) size = images[i].size();
-    if (images[i].size() != size)
-      throw InputError("ChArUco calibration: image " + std::to_string(i) + " differs in size from the first; "
-                       "calibrate one camera mode at a time");
-    if (auto c = detect_charuco(images[i], spec)) {
-      corners.push_back(std::move(c->corners));
-      ids.push_back(std::move(c->ids));
-      out.used_views.push_back(int(i));
+  if (images.empty()) throw InputError("ChArUco calibration: no images given; pass the board photographs");
+  BoardViews views;
+  views.image_size = images.front().image.size();
+  for (const auto& named : images) {
+    if (named.image.size() != views.image_size)
+      throw InputError(named.name + ": image size differs from " + images.front().name +
+                       "; calibrate one camera mode at a time");
+    auto found = detect_charuco(named.image, spec);
+    if (!found) {
+      views.views_without_board.push_back(named.name);
+      continue;
     }
+    std::vector<cv::Point3f> objects;
+    for (int id : found->ids) objects.push_back(board->chessboardCorners[std::size_t(id)]);
+    views.corners.push_back(std::move(found->corners));
+    views.objects.push_back(std::move(objects));
+    views.names.push_back(named.name);
   }
-  if (corners.size() < 3)
-    throw InputError("ChArUco calibration: the board was found in " + std::to_string(corners.size()) + " of " +
-                     std::to_string(images.size()) + " images; at least 3 are needed (check --charuco, --dict)");
-  cv::Mat K, D, std_intrinsics, std_extrinsics, per_view;
-  std::vector<cv::Mat> rvecs, tvecs;
-  const double rms = cv::aruco::calibrateCameraCharuco(corners, ids, board, size, K, D, rvecs, tvecs, std_intrinsics,
-                                                       std_extrinsics, per_view, flags);
-  CameraIntrinsics& c = out.camera.intrinsics;
-  c.width = size.width, c.height = size.height;
-  c.fx = K.at<double>(0, 0), c.fy = K.at<double>(1, 1), c.cx = K.at<double>(0, 2), c.cy = K.at<double>(1, 2);
-  for (int i = 0; i < 5 && i < int(D.total()); ++i) c.distortion[std::size_t(i)] = D.at<double>(i);
-  out.camera.avg_reprojection_error = rms;
-  for (int i = 0; i < 9 && i < int(std_intrinsics.total()); ++i) out.std_dev[std::size_t(i)] = std_intrinsics.at<double>(i);
-  for (int i = 0; i < int(per_view.total()); ++i) out.per_view_rms.push_back(per_view.at<double>(i));
-  return out;
+  require_board_views(views, images.size(),
+                      std::to_string(spec.squares_x) + "x" + std::to_string(spec.squares_y) + "-square ChArUco board (" +
+                          spec.dictionary + ", check --charuco and --dict)");
+  return views;
 }
 
 }  // namespace lumar::calib

@@ -1,8 +1,8 @@
 #include "lumar/calib/checkerboard_calibration.h"
 
+#include <algorithm>
 #include <cmath>
 #include <opencv2/calib3d.hpp>
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "lumar/core/error.h"
@@ -23,75 +23,65 @@ std::vector<cv::Point3f> checkerboard_points(cv::Size inner_corners, double squa
   return board;
 }
 
-CheckerboardViews detect_checkerboard_views(const std::vector<std::filesystem::path>& images,
-                                            cv::Size inner_corners, double square_size_m) {
+BoardViews detect_checkerboard_views(const std::vector<NamedImage>& images, cv::Size inner_corners,
+                                     double square_size_m) {
   if (images.empty()) throw InputError("checkerboard calibration: no images given; pass the board photographs");
   if (inner_corners.width < 2 || inner_corners.height < 2)
     throw InputError("checkerboard calibration: board size " + size_text(inner_corners) +
                      " is too small; give the inner corners, e.g. 9x6 for a 10x7-square board");
   if (!(square_size_m > 0.0) || !std::isfinite(square_size_m))
     throw InputError("checkerboard calibration: square size must be a positive length in metres");
-
-  CheckerboardViews result;
-  result.board = checkerboard_points(inner_corners, square_size_m);
-  auto& image_points = result.corners;
-  cv::Size& image_size = result.image_size;
-  std::string first_image;
-  for (const auto& path : images) {
-    const std::string name = path.string();
-    if (!std::filesystem::is_regular_file(path))
-      throw InputError(name + ": image not found; check the path or remove it from the list");
-    const cv::Mat gray = cv::imread(name, cv::IMREAD_GRAYSCALE);
-    if (gray.empty())
-      throw InputError(name + ": cannot read image (missing or not an image file); remove it from the list");
-    if (image_size.empty()) {
-      image_size = gray.size();
-      first_image = name;
-    } else if (gray.size() != image_size) {
-      throw InputError(name + ": image is " + size_text(gray.size()) + " but " + first_image + " is " +
-                       size_text(image_size) + "; calibrate one camera mode at a time");
-    }
+  const std::vector<cv::Point3f> board = checkerboard_points(inner_corners, square_size_m);
+  BoardViews result;
+  result.image_size = images.front().image.size();
+  for (const auto& named : images) {
+    if (named.image.size() != result.image_size)
+      throw InputError(named.name + ": image is " + size_text(named.image.size()) + " but " + images.front().name +
+                       " is " + size_text(result.image_size) + "; calibrate one camera mode at a time");
+    cv::Mat grey;
+    if (named.image.channels() == 3)
+      cv::cvtColor(named.image, grey, cv::COLOR_BGR2GRAY);
+    else
+      grey = named.image;
     std::vector<cv::Point2f> corners;
-    const bool found = cv::findChessboardCorners(
-        gray, inner_corners, corners, cv::CALIB_CB_ADAPTIVE_THRESH | cv::CALIB_CB_NORMALIZE_IMAGE);
-    if (!found) {
-      result.views_without_board.push_back(name);
+    // FAST_CHECK: video frames without the board are rejected quickly.
+    if (!cv::findChessboardCorners(grey, inner_corners, corners,
+                                   cv::CALIB_CB_ADAPTIVE_THRESH | cv::CALIB_CB_NORMALIZE_IMAGE | cv::CALIB_CB_FAST_CHECK)) {
+      result.views_without_board.push_back(named.name);
       continue;
     }
-    cv::cornerSubPix(gray, corners, cv::Size(11, 11), cv::Size(-1, -1),
+    // OpenCV's 11 px half-window (its calibration sample's), narrowed only where it would
+    // reach the neighbouring corner: a small board far away in a video frame.
+    double spacing = 1e9;
+    for (std::size_t i = 0; i + 1 < corners.size(); ++i)
+      if ((i + 1) % std::size_t(inner_corners.width) != 0)
+        spacing = std::min(spacing, double(cv::norm(corners[i + 1] - corners[i])));
+    const int half = std::clamp(int(spacing) - 2, 3, 11);
+    cv::cornerSubPix(grey, corners, cv::Size(half, half), cv::Size(-1, -1),
                      cv::TermCriteria(cv::TermCriteria::EPS | cv::TermCriteria::COUNT, 30, 0.0001));
-    image_points.push_back(std::move(corners));
-    result.names.push_back(name);
+    result.corners.push_back(std::move(corners));
+    result.objects.push_back(board);
+    result.names.push_back(named.name);
   }
-  if (image_points.empty())
-    throw InputError("checkerboard calibration: no " + size_text(inner_corners) +
-                     " inner-corner board found in any of the " + std::to_string(images.size()) +
-                     " images; check the board size (inner corners, not squares)");
-  if (image_points.size() < 3)
-    throw InputError("checkerboard calibration: the board was found in only " +
-                     std::to_string(image_points.size()) + " image(s); at least 3 views are needed, "
-                     "better 10 or more at varied angles");
-
+  require_board_views(result, images.size(), size_text(inner_corners) + " inner-corner board (inner corners, not squares)");
   return result;
 }
 
 CalibrationResult calibrate_checkerboard(const std::vector<std::filesystem::path>& images,
                                          cv::Size inner_corners, double square_size_m) {
-  const CheckerboardViews views = detect_checkerboard_views(images, inner_corners, square_size_m);
-  const auto& board = views.board;
+  const BoardViews views = detect_checkerboard_views(load_board_images(images), inner_corners, square_size_m);
   const auto& image_points = views.corners;
   const cv::Size image_size = views.image_size;
   CalibrationResult result;
   result.used_views = views.names;
   result.views_without_board = views.views_without_board;
-  const std::vector<std::vector<cv::Point3f>> object_points(image_points.size(), board);
   cv::Mat K, D;
   std::vector<cv::Mat> rvecs, tvecs;
-  const double rms = cv::calibrateCamera(object_points, image_points, image_size, K, D, rvecs, tvecs);
+  const double rms = cv::calibrateCamera(views.objects, image_points, image_size, K, D, rvecs, tvecs);
 
   for (std::size_t i = 0; i < image_points.size(); ++i) {
     std::vector<cv::Point2f> projected;
-    cv::projectPoints(board, rvecs[i], tvecs[i], K, D, projected);
+    cv::projectPoints(views.objects[i], rvecs[i], tvecs[i], K, D, projected);
     double sum = 0.0;
     for (std::size_t j = 0; j < projected.size(); ++j) {
       const cv::Point2f e = projected[j] - image_points[i][j];

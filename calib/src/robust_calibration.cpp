@@ -34,10 +34,13 @@ double rms_of(const std::vector<cv::Point2f>& a, const std::vector<cv::Point2f>&
   return std::sqrt(sum / double(a.size()));
 }
 
-Solve solve(const CheckerboardViews& views, const std::vector<int>& subset, const RobustCalibrationOptions& o) {
+Solve solve(const BoardViews& views, const std::vector<int>& subset, const RobustCalibrationOptions& o) {
   std::vector<std::vector<cv::Point2f>> image_points;
-  for (int i : subset) image_points.push_back(views.corners[i]);
-  const std::vector<std::vector<cv::Point3f>> object_points(image_points.size(), views.board);
+  std::vector<std::vector<cv::Point3f>> object_points;
+  for (int i : subset) {
+    image_points.push_back(views.corners[i]);
+    object_points.push_back(views.objects[i]);
+  }
   // With CALIB_FIX_ASPECT_RATIO OpenCV keeps the initial fx/fy ratio: start from 1.
   cv::Mat K = cv::Mat::eye(3, 3, CV_64F), D;
   std::vector<cv::Mat> tvecs;
@@ -56,7 +59,7 @@ Solve solve(const CheckerboardViews& views, const std::vector<int>& subset, cons
   for (int i = 0; i < 9; ++i) s.std_dev[i] = std_intrinsics.at<double>(i);
   for (std::size_t i = 0; i < image_points.size(); ++i) {
     std::vector<cv::Point2f> projected;
-    cv::projectPoints(views.board, s.rvecs[i], tvecs[i], K, D, projected);
+    cv::projectPoints(object_points[i], s.rvecs[i], tvecs[i], K, D, projected);
     s.per_view_rms.push_back(rms_of(projected, image_points[i]));
   }
   return s;
@@ -70,7 +73,7 @@ double median(std::vector<double> v) {
 
 // Held-out error of one split: intrinsics from `train`, then each test view's pose
 // from its own corners (solvePnP) and the RMS of all test corners.
-double holdout_rms(const CheckerboardViews& views, const std::vector<int>& train, const std::vector<int>& test,
+double holdout_rms(const BoardViews& views, const std::vector<int>& train, const std::vector<int>& test,
                    const RobustCalibrationOptions& o, double* training_rms) {
   const Solve s = solve(views, train, o);
   *training_rms = s.rms;
@@ -80,9 +83,9 @@ double holdout_rms(const CheckerboardViews& views, const std::vector<int>& train
   std::size_t count = 0;
   for (int i : test) {
     cv::Mat rvec, tvec;
-    cv::solvePnP(views.board, views.corners[i], K, D, rvec, tvec);
+    cv::solvePnP(views.objects[i], views.corners[i], K, D, rvec, tvec);
     std::vector<cv::Point2f> projected;
-    cv::projectPoints(views.board, rvec, tvec, K, D, projected);
+    cv::projectPoints(views.objects[i], rvec, tvec, K, D, projected);
     const double r = rms_of(projected, views.corners[i]);
     sum += r * r * double(projected.size());
     count += projected.size();
@@ -108,11 +111,9 @@ int distinct_orientations(const std::vector<cv::Mat>& rvecs, double separation_d
 
 }  // namespace
 
-RobustCalibrationResult calibrate_robust(const CheckerboardViews& views, const RobustCalibrationOptions& o) {
+RobustCalibrationResult calibrate_robust(const BoardViews& views, const RobustCalibrationOptions& o) {
   const int n = int(views.corners.size());
-  if (n < 3)
-    throw InputError("checkerboard calibration: the board was found in only " + std::to_string(n) +
-                     " image(s); at least 3 views are needed, better 10 or more at varied angles");
+  require_board_views(views, views.names.size() + views.views_without_board.size(), "board");
   RobustCalibrationResult result;
   result.views_without_board = views.views_without_board;
 

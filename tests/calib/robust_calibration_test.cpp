@@ -13,14 +13,15 @@
 #include <random>
 
 #include "lumar/calib/calibration_report.h"
+#include "lumar/calib/checkerboard_calibration.h"
 #include "lumar/core/error.h"
 #include "test_paths.h"
 
 namespace lumar::calib {
 namespace {
 
-const CheckerboardViews& real_views() {
-  static const CheckerboardViews views = detect_checkerboard_views(test::checkerboard_images(), {9, 6}, 0.025);
+const BoardViews& real_views() {
+  static const BoardViews views = detect_checkerboard_views(load_board_images(test::checkerboard_images()), {9, 6}, 0.025);
   return views;
 }
 
@@ -53,11 +54,11 @@ TEST(RobustCalibration, RealImagesRejectTheInconsistentView) {
 
 TEST(RobustCalibration, KeptViewsMatchOpenCVsOwnCalibration) {
   const RobustCalibrationResult& r = real_result();
-  const CheckerboardViews& v = real_views();
+  const BoardViews& v = real_views();
   std::vector<std::vector<cv::Point2f>> points;
   for (const auto& name : r.used_views)
     points.push_back(v.corners[std::size_t(std::find(v.names.begin(), v.names.end(), name) - v.names.begin())]);
-  const std::vector<std::vector<cv::Point3f>> objects(points.size(), v.board);
+  const std::vector<std::vector<cv::Point3f>> objects(points.size(), checkerboard_points({9, 6}, 0.025));
   cv::Mat K, D;
   std::vector<cv::Mat> rvecs, tvecs;
   const double rms = cv::calibrateCamera(objects, points, v.image_size, K, D, rvecs, tvecs);
@@ -159,7 +160,7 @@ TEST(RobustCalibration, ReportFileIsReadableAsACameraFile) {
 // sigma 0.2 px, and one view with sigma 3 px.
 struct Synthetic {
   CameraIntrinsics truth;
-  CheckerboardViews views;
+  BoardViews views;
 };
 
 Synthetic synthetic_views(int count, int bad_view, std::uint32_t seed) {
@@ -172,9 +173,9 @@ Synthetic synthetic_views(int count, int bad_view, std::uint32_t seed) {
   t.cx = 322;
   t.cy = 236;
   t.distortion = {-0.2, 0.08, 0.001, -0.0005, 0.0};
-  CheckerboardViews& v = s.views;
+  BoardViews& v = s.views;
   v.image_size = {t.width, t.height};
-  v.board = checkerboard_points({9, 6}, 0.025);
+  const std::vector<cv::Point3f> board = checkerboard_points({9, 6}, 0.025);
   std::mt19937 rng(seed);
   std::uniform_real_distribution<double> angle(-0.5, 0.5), shift(-0.06, 0.06), depth(0.35, 0.6);
   std::normal_distribution<double> noise(0.0, 1.0);
@@ -187,7 +188,7 @@ Synthetic synthetic_views(int count, int bad_view, std::uint32_t seed) {
     const cv::Vec3d centre(0.1, 0.0625, 0);  // of the 9x6 board, metres
     const cv::Vec3d tvec = cv::Vec3d(shift(rng), shift(rng), depth(rng)) - R * centre;
     std::vector<cv::Point2f> projected;
-    cv::projectPoints(v.board, rvec, tvec, K, D, projected);
+    cv::projectPoints(board, rvec, tvec, K, D, projected);
     const bool inside = std::all_of(projected.begin(), projected.end(), [&](const cv::Point2f& p) {
       return p.x > 5 && p.y > 5 && p.x < t.width - 5 && p.y < t.height - 5;
     });
@@ -196,6 +197,7 @@ Synthetic synthetic_views(int count, int bad_view, std::uint32_t seed) {
     for (auto& p : projected) p += cv::Point2f(float(sigma * noise(rng)), float(sigma * noise(rng)));
     v.names.push_back("view" + std::to_string(v.corners.size()));
     v.corners.push_back(std::move(projected));
+    v.objects.push_back(board);
   }
   return s;
 }

@@ -15,7 +15,7 @@ void save_calibration_report(const std::filesystem::path& path, const RobustCali
 // PNG (or any cv::imwrite format, by extension) of the sensor: the coverage grid's
 // occupied cells shaded, each kept view's corners as dots of its own colour, rejected
 // views' corners as grey crosses. Atomic write.
-void write_coverage_image(const std::filesystem::path& path, const CheckerboardViews& views,
+void write_coverage_image(const std::filesystem::path& path, const BoardViews& views,
                           const RobustCalibrationResult& result, const RobustCalibrationOptions& options = {});
 
 }  // namespace lumar::calib

@@ -1,14 +1,13 @@
 #pragma once
-// Camera intrinsics from ChArUco boards (OpenCV 4.6 contrib aruco): a checkerboard whose
+// ChArUco boards (OpenCV 4.6 contrib aruco): a checkerboard whose
 // white squares hold ArUco markers, so that corners are identified even when the board
 // is only partly in view.
-#include <array>
 #include <opencv2/core.hpp>
 #include <optional>
 #include <string>
 #include <vector>
 
-#include "lumar/calib/camera_file.h"
+#include "lumar/calib/board_views.h"
 
 namespace lumar::calib {
 
@@ -35,16 +34,11 @@ struct CharucoCorners {
 // `min_corners` corners.
 std::optional<CharucoCorners> detect_charuco(const cv::Mat& image, const CharucoBoardSpec& board, int min_corners = 6);
 
-struct CharucoCalibration {
-  CameraFile camera;             // avg_reprojection_error = RMS over all corners
-  std::array<double, 9> std_dev{};  // fx fy cx cy k1 k2 p1 p2 k3 (kIntrinsicNames)
-  std::vector<double> per_view_rms;
-  std::vector<int> used_views;   // indices into the images with enough corners
-};
-
-// cv::aruco::calibrateCameraCharuco over the images where the board is found. Throws
-// InputError for an unknown dictionary, a marker not smaller than its square, images of
+// The board's chessboard corners found in each image, with their board-plane points
+// (views with fewer than 6 corners are listed as without the board), ready for
+// calibrate_robust (robust_calibration.h) like checkerboard views. Throws InputError for
+// an unknown dictionary, a marker not smaller than its square, no images, images of
 // different sizes, or fewer than 3 views with the board.
-CharucoCalibration calibrate_charuco(const std::vector<cv::Mat>& images, const CharucoBoardSpec& board, int flags = 0);
+BoardViews detect_charuco_views(const std::vector<NamedImage>& images, const CharucoBoardSpec& board);
 
 }  // namespace lumar::calib

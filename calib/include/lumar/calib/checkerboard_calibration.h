@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "lumar/calib/board_views.h"
 #include "lumar/calib/camera_file.h"
 
 namespace lumar::calib {
@@ -17,27 +18,19 @@ struct CalibrationResult {
   std::vector<std::string> views_without_board;  // images where it was not
 };
 
-// Board corners found in a set of photographs, before any solving.
-struct CheckerboardViews {
-  cv::Size image_size;
-  std::vector<cv::Point3f> board;                     // corners in the board plane, metres, z = 0
-  std::vector<std::string> names;                     // one per view with the board (paths as given)
-  std::vector<std::vector<cv::Point2f>> corners;      // sub-pixel corners, same order as `board`
-  std::vector<std::string> views_without_board;
-};
-
 // The board's corners in its own plane, row by row as findChessboardCorners orders them.
 std::vector<cv::Point3f> checkerboard_points(cv::Size inner_corners, double square_size_m);
 
-// Finds the board in each image (sub-pixel refined). Throws InputError as
-// calibrate_checkerboard does (it uses this).
-CheckerboardViews detect_checkerboard_views(const std::vector<std::filesystem::path>& images,
-                                            cv::Size inner_corners, double square_size_m);
+// Finds the board in each image (sub-pixel refined; views without it are listed). Throws
+// InputError for no images, a bad board size or square, images of different sizes, or
+// fewer than 3 views where the board is found.
+BoardViews detect_checkerboard_views(const std::vector<NamedImage>& images, cv::Size inner_corners,
+                                     double square_size_m);
 
 // Plain calibration, every view kept (robust_calibration.h drops outliers).
 // inner_corners: corners where four squares meet, e.g. 9x6 for a 10x7-square board.
-// Throws InputError for no images, an unreadable image, images of different sizes,
-// or fewer than 3 views where the board is found.
+// The reference beside calibrate_robust: plain cv::calibrateCamera on every view.
+// Throws InputError as load_board_images and detect_checkerboard_views do.
 CalibrationResult calibrate_checkerboard(const std::vector<std::filesystem::path>& images,
                                          cv::Size inner_corners, double square_size_m);
 

@@ -1,12 +1,13 @@
 #pragma once
-// Checkerboard calibration that drops inconsistent views, reports the uncertainty of
+// Camera calibration from board views (checkerboard or ChArUco) that drops inconsistent views, reports the uncertainty of
 // every intrinsic, a cross-validated error and how well the views cover the sensor.
 #include <array>
 #include <cstdint>
 #include <string>
 #include <vector>
 
-#include "lumar/calib/checkerboard_calibration.h"
+#include "lumar/calib/board_views.h"
+#include "lumar/calib/camera_file.h"
 
 namespace lumar::calib {
 
@@ -58,6 +59,6 @@ struct RobustCalibrationResult {
 
 // Throws InputError when fewer than 3 views hold the board (what the model needs).
 // Rejection stops at options.min_views; the held-out error needs 6 views (else 0 splits).
-RobustCalibrationResult calibrate_robust(const CheckerboardViews& views, const RobustCalibrationOptions& options = {});
+RobustCalibrationResult calibrate_robust(const BoardViews& views, const RobustCalibrationOptions& options = {});
 
 }  // namespace lumar::calib
