@@ -64,10 +64,12 @@ case_record_survives_kill_9() {
 }
 
 case_record_rides_through_disconnections() {
-  # Outages at 2 s and 4 s after the emulator started (the recorder must find the port
-  # at its start, so the first outage leaves it time to start even on a loaded machine).
+  # Outages every 2 s after the emulator started (the recorder must find the port at its
+  # start, so the first outage leaves it time to start even on a loaded machine). Seven
+  # seconds of recording span at least two outages and the reconnection after them, even
+  # when a loaded machine starts the recorder a second late and reconnects slowly.
   start_emulator --rate 60 --disconnect-every 2 --disconnect-for 0.3
-  "$LUMAR" tracker record --port "serial:$TMP/tty" --out "$TMP/rec" --watchdog 0.5 --duration 4.8 \
+  "$LUMAR" tracker record --port "serial:$TMP/tty" --out "$TMP/rec" --watchdog 0.5 --duration 7 \
     >"$TMP/record.log" 2>&1 || { cat "$TMP/record.log"; fail "record failed"; }
   stop_emulator
   cat "$TMP/record.log"
