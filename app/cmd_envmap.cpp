@@ -1,23 +1,16 @@
-// lumar envmap: stitch an HDR lat-long environment map from a recorded, tracked sweep.
-#include <unistd.h>
-
-#include <algorithm>
-#include <chrono>
-#include <cmath>
-#include <cstdio>
-#include <fstream>
-#include <memory>
-#include <optional>
+// lumar envmap: stitch an HDR lat-long environment map from a tracked sweep: a
+// recording, a folder of images with poses, or a live camera with a tracker.
 #include <spdlog/spdlog.h>
 
+#include <memory>
+
 #include "commands.h"
+#include "envmap_images.h"
+#include "envmap_live.h"
+#include "envmap_sweep.h"
 #include "lumar/calib/camera_file.h"
 #include "lumar/calib/camera_response.h"
-#include "lumar/calib/envmap_stitcher.h"
-#include "lumar/calib/hole_filling.h"
-#include "lumar/calib/orientation_refinement.h"
 #include "lumar/capture/recording_replay.h"
-#include "lumar/core/envmap.h"
 #include "lumar/core/error.h"
 
 namespace lumar::app {
@@ -25,35 +18,11 @@ namespace lumar::app {
 namespace {
 
 struct EnvmapOptions {
-  std::string recording, out, coverage, preview, camera, corrections;
-  int width = 1024;
-  bool no_refine = false;
-  bool no_fill = false;
-  std::optional<double> azimuth_offset_deg;
-};
-
-// A progress bar on stderr: redrawn in place on a terminal, a line per tenth otherwise.
-class Progress {
- public:
-  Progress(std::string what, int total) : what_(std::move(what)), total_(std::max(1, total)), tty_(isatty(2)) {}
-  void update(int done) {
-    const int tenth = done * 10 / total_;
-    if (tty_) {
-      const int filled = done * 30 / total_;
-      std::fprintf(stderr, "\r%s [%s%s] %d/%d", what_.c_str(), std::string(filled, '#').c_str(),
-                   std::string(30 - filled, ' ').c_str(), done, total_);
-      if (done == total_) std::fprintf(stderr, "\n");
-    } else if (tenth != last_tenth_) {
-      std::fprintf(stderr, "%s: %d/%d\n", what_.c_str(), done, total_);
-    }
-    last_tenth_ = tenth;
-  }
-
- private:
-  std::string what_;
-  int total_;
-  bool tty_;
-  int last_tenth_ = -1;
+  EnvmapOutputOptions out;
+  std::string recording, export_images;
+  std::string camera;  // --recording: instead of the session's; --images: required
+  ImagesInputOptions images;
+  LiveEnvmapOptions live;
 };
 
 calib::CameraResponse response_of(const capture::Session& session, const std::filesystem::path& dir) {
@@ -61,53 +30,58 @@ calib::CameraResponse response_of(const capture::Session& session, const std::fi
   return calib::load_camera_response(dir / session.radiometry.response);
 }
 
-void run_envmap(const EnvmapOptions& o) {
-  const std::filesystem::path dir = o.recording;
-  if (o.width <= 0 || o.width % 2 != 0 || o.width > 16384)
-    throw InputError("--width " + std::to_string(o.width) + ": expected an even number of pixels up to 16384");
-  const capture::RecordingReplay replay(dir);
-  const capture::RecordingReader& reader = replay.reader();
-  const capture::Session& session = replay.session();
+// The recording's frames, the tracker's rotation at each frame's time, the exposures
+// (session "frame_exposures", cycled, or its one exposure), brackets as groups.
+SweepInput recording_sweep_input(const std::string& recording, const std::string& camera_file, int width) {
+  const std::filesystem::path dir = recording;
+  auto replay = std::make_shared<const capture::RecordingReplay>(dir);
+  const capture::RecordingReader& reader = replay->reader();
+  const capture::Session& session = replay->session();
   const auto& frames = reader.frames();
   if (frames.empty()) throw InputError(dir.string() + ": the recording has no frames; record a sweep first");
 
+  SweepInput in;
+  in.name = dir.string();
   CameraIntrinsics camera = session.camera;
   std::string camera_name = (dir / capture::kSessionFile).string();
-  if (!o.camera.empty()) {
-    camera = calib::load_camera_file(o.camera).intrinsics;
-    camera_name = o.camera;
+  if (!camera_file.empty()) {
+    camera = calib::load_camera_file(camera_file).intrinsics;
+    camera_name = camera_file;
   }
   const cv::Size size = reader.video().size;
   if (camera.width != size.width || camera.height != size.height)
     throw InputError(camera_name + ": the calibration is for " + std::to_string(camera.width) + "x" +
                      std::to_string(camera.height) + " but the recording's frames are " + std::to_string(size.width) +
                      "x" + std::to_string(size.height) + "; use the calibration of the camera that recorded it");
-  if (replay.tracker_stats().records == 0)
+  if (replay->tracker_stats().records == 0)
     throw InputError(dir.string() + ": the recording has no tracker poses; a sweep needs the tracker's stream");
 
-  // Every frame needs a rotation from the tracker.
-  std::vector<glm::dquat> tracked;
   glm::dvec3 mean_position(0.0);
   for (const auto& f : frames) {
-    const auto pose = replay.tracked_camera_pose(f.time);
+    const auto pose = replay->tracked_camera_pose(f.time);
     if (!pose)
       throw InputError(dir.string() + ": the tracker poses do not cover frame " + std::to_string(f.index) + " at " +
                        std::to_string(nanos_to_seconds(f.time)) +
                        " s; the tracker must run from before the first frame to after the last");
-    tracked.push_back(pose->rotation);
+    in.rotations.push_back(pose->rotation);
+    in.labels.push_back(std::to_string(f.index) + "," + std::to_string(f.time));
     mean_position += pose->translation / double(frames.size());
   }
+  in.label_header = "index,time_ns";
 
-  // Exposure per frame: a list cycled over the frames, or the session's one exposure.
   std::vector<double> exposures{session.radiometry.exposure};
   if (session.extra.contains("frame_exposures")) exposures = session.extra["frame_exposures"].get<std::vector<double>>();
   for (double e : exposures)
     if (!(e > 0) || !std::isfinite(e))
       throw InputError((dir / capture::kSessionFile).string() + ": exposures must be positive numbers");
-  auto exposure_of = [&](std::int64_t index) { return exposures[std::size_t(index) % exposures.size()]; };
+  const bool bracket = session.extra.value("exposure_bracket", false);
+  for (const auto& f : frames) {
+    in.exposures.push_back(exposures[std::size_t(f.index) % exposures.size()]);
+    if (bracket) in.groups.push_back(int(f.index / std::int64_t(exposures.size())));
+  }
 
-  calib::StitchSettings st;
-  st.width = o.width;
+  calib::StitchSettings& st = in.stitch;
+  st.width = width;
   st.camera = camera;
   st.response = response_of(session, dir);
   st.vignetting_a = session.radiometry.vignetting_a;
@@ -120,103 +94,94 @@ void run_envmap(const EnvmapOptions& o) {
       if (p.size() == 3) st.capture_position = {p[0], p[1], p[2]};
     }
     st.azimuth_offset_deg = e.value("azimuth_offset_deg", 0.0);
+    // The map a synthetic sweep was made from: the output is compared with it.
+    const std::string source_map = e.value("source_map", std::string());
+    if (std::error_code ec; !source_map.empty() && std::filesystem::exists(source_map, ec))
+      in.default_reference = source_map;
   }
-  if (o.azimuth_offset_deg) st.azimuth_offset_deg = *o.azimuth_offset_deg;
+  if (session.extra.contains("synth")) in.tracker_noise_deg = session.extra["synth"].value("tracker_noise_deg", 0.75);
 
+  if (!reader.truth().empty())
+    for (const auto& f : frames) {
+      const auto truth = replay->true_camera_pose(f.index);
+      in.truth.push_back(truth ? std::optional<glm::dquat>(truth->rotation) : std::nullopt);
+    }
   const int n = int(frames.size());
-  auto read_all = [&](const std::string& what, const std::function<void(const capture::Frame&, int)>& use) {
-    auto source = replay.open_frames();
-    Progress progress(what, n);
+  in.read_frames = [replay, n](const std::function<void(const cv::Mat&, int)>& use) {
+    auto source = replay->open_frames();
     capture::Frame frame;
-    int k = 0;
-    while (k < n && source->read(frame)) {
-      use(frame, k);
-      progress.update(++k);
-    }
-    if (k < n) throw InputError(dir.string() + ": the video ended after " + std::to_string(k) + " of " +
-                                std::to_string(n) + " frames; the recording is damaged");
+    for (int k = 0; k < n && source->read(frame); ++k) use(frame.image, k);
   };
+  return in;
+}
 
-  std::vector<glm::dquat> rotations = tracked;
-  if (!o.no_refine) {
-    std::vector<calib::FrameFeatures> features(n);
-    read_all("features", [&](const capture::Frame& f, int k) {
-      features[k] = calib::extract_frame_features(f.image, camera, st.response);
-    });
-    calib::RefinementSettings rs;
-    if (session.extra.contains("synth")) rs.tracker_noise_deg = session.extra["synth"].value("tracker_noise_deg", 0.75);
-    rs.tracker_noise_deg = std::max(rs.tracker_noise_deg, 0.05);
-    // A bracket (session "exposure_bracket") was taken standing still: one rotation.
-    std::vector<int> groups;
-    if (session.extra.value("exposure_bracket", false))
-      for (const auto& f : frames) groups.push_back(int(f.index / std::int64_t(exposures.size())));
-    const auto result = calib::refine_orientations(features, tracked, rs, groups);
-    rotations = result.rotations;
-    double mean = 0, worst = 0;
-    for (double c : result.correction_deg) mean += c / n, worst = std::max(worst, c);
-    spdlog::info("envmap: refined {} frames from {} pairs ({} matches, {} frames unmatched): corrections mean {:.3f} "
-                 "deg, max {:.3f} deg; match residual {:.3f} -> {:.3f} deg RMS",
-                 n, result.pairs, result.matches, result.unmatched_frames, mean, worst, result.residual_before_deg,
-                 result.residual_after_deg);
-    if (!o.corrections.empty()) {
-      const std::filesystem::path path = o.corrections, tmp = path.string() + ".tmp";
-      {
-        std::ofstream out(tmp);
-        out << "index,time_ns,correction_deg,qw,qx,qy,qz\n";
-        for (int k = 0; k < n; ++k)
-          out << frames[k].index << ',' << frames[k].time << ',' << result.correction_deg[k] << ','
-              << rotations[k].w << ',' << rotations[k].x << ',' << rotations[k].y << ',' << rotations[k].z << '\n';
-        if (!out) throw InputError(o.corrections + ": cannot write the corrections; check the folder");
-      }
-      std::filesystem::rename(tmp, path);
-    }
+void run_envmap(EnvmapOptions& o) {
+  const int inputs = int(!o.recording.empty()) + int(!o.images.images.empty()) + int(!o.live.in.source.empty());
+  if (inputs != 1) throw InputError("envmap: give exactly one of --recording DIR, --images DIR_OR_GLOB, --source SPEC");
+  check_map_width(o.out.width);
+  if (o.out.out.empty() && o.export_images.empty()) throw InputError("envmap: --out OUT.exr is required");
+  if (std::error_code ec; !o.out.reference.empty() && !std::filesystem::is_regular_file(o.out.reference, ec))
+    throw InputError(o.out.reference + ": no such reference map; check --reference");
+  if (!o.export_images.empty() && o.recording.empty())
+    throw InputError("--export-images writes a recording's frames; it needs --recording");
+  if (!o.live.in.source.empty()) {
+    if (!o.out.corrections.empty() && !o.live.refine_at_end)
+      throw InputError("--corrections: a live sweep is refined only with --refine-at-end");
+    o.live.out = o.out;
+    o.live.in.camera_file = o.camera;
+    o.live.response = o.images.response;
+    o.live.vignetting_a = o.images.vignetting_a;
+    o.live.vignetting_b = o.images.vignetting_b;
+    o.live.tracker_noise_deg = o.images.tracker_noise_deg;
+    run_live_envmap(o.live);
+    return;
   }
-  // With ground truth (synthetic recordings), say how close the rotations came.
-  if (!reader.truth().empty()) {
-    double before = 0, after = 0;
-    int m = 0;
-    for (int k = 0; k < n; ++k)
-      if (auto truth = replay.true_camera_pose(frames[k].index)) {
-        before += std::pow(rotation_angle_deg(tracked[k], truth->rotation), 2);
-        after += std::pow(rotation_angle_deg(rotations[k], truth->rotation), 2);
-        ++m;
-      }
-    if (m > 0)
-      spdlog::info("envmap: rotation error against truth: tracker {:.3f} deg RMS, used {:.3f} deg RMS",
-                   std::sqrt(before / m), std::sqrt(after / m));
+  SweepInput in;
+  if (!o.recording.empty()) {
+    in = recording_sweep_input(o.recording, o.camera, o.out.width);
+  } else {
+    o.images.camera = o.camera;
+    in = images_sweep_input(o.images, o.out.width);
   }
-
-  calib::EnvmapStitcher stitcher(st);
-  const auto t0 = std::chrono::steady_clock::now();
-  read_all("stitching", [&](const capture::Frame& f, int k) { stitcher.add_frame(f.image, rotations[k], exposure_of(f.index)); });
-  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  EnvironmentMap map = stitcher.current_map();
-  const cv::Mat coverage = stitcher.coverage();
-  const int covered = cv::countNonZero(coverage);
-  int filled = 0;
-  if (!o.no_fill && covered > 0) filled = calib::fill_holes_push_pull(map, coverage);
-  save_environment_map(o.out, map);
-  if (!o.coverage.empty()) calib::write_image_atomically(o.coverage, calib::coverage_image(coverage));
-  if (!o.preview.empty()) calib::write_image_atomically(o.preview, calib::contact_sheet(map, coverage));
-  spdlog::info("envmap: wrote {} ({}x{}, {:.1f} % covered, {} pixels filled; {} frames in {:.2f} s incl. decoding)",
-               o.out, map.width, map.height, 100.0 * covered / coverage.total(), filled, n, seconds);
+  if (o.out.azimuth_offset_deg) in.stitch.azimuth_offset_deg = *o.out.azimuth_offset_deg;
+  if (!o.export_images.empty()) {
+    export_sweep_images(in, o.export_images);
+    spdlog::info("envmap: wrote {} frames and their poses to {}", in.rotations.size(), o.export_images);
+    if (o.out.out.empty()) return;
+  }
+  stitch_sweep(in, o.out);
 }
 
 }  // namespace
 
 void register_envmap(CLI::App& app) {
   auto o = std::make_shared<EnvmapOptions>();
-  auto* cmd = app.add_subcommand("envmap", "Stitch an HDR environment map from a recorded, tracked camera sweep");
-  cmd->add_option("--recording", o->recording, "Recording directory of the sweep")->required();
-  cmd->add_option("--out", o->out, "Output map (OpenEXR, float RGB)")->required();
-  cmd->add_option("--width", o->width, "Map width in pixels (height = width / 2)")->capture_default_str();
-  cmd->add_flag("--no-refine", o->no_refine, "Use the tracker's rotations as they are");
-  cmd->add_flag("--no-fill", o->no_fill, "Leave uncovered pixels black instead of filling them");
-  cmd->add_option("--coverage", o->coverage, "Write a coverage map (PNG): magenta holes, grey by frame count");
-  cmd->add_option("--preview", o->preview, "Write a tone-mapped contact sheet (PNG) at -4, 0, +4 stops");
-  cmd->add_option("--corrections", o->corrections, "Write each frame's refined rotation and correction (CSV)");
-  cmd->add_option("--camera", o->camera, "Camera calibration to use instead of the recording's");
-  cmd->add_option("--azimuth-offset", o->azimuth_offset_deg, "Azimuth offset of the map about +Y, degrees");
+  auto* cmd = app.add_subcommand("envmap",
+                                 "Stitch an HDR environment map from a tracked camera sweep: a recording, images with "
+                                 "poses, or a live camera with a tracker");
+  cmd->add_option("--recording", o->recording, "Recording directory of the sweep");
+  cmd->add_option("--images", o->images.images, "Folder or glob of the sweep's images (with --poses and --camera)");
+  cmd->add_option("--poses", o->images.poses, "--images: CSV file,qw,qx,qy,qz[,x,y,z][,exposure][,station]");
+  cmd->add_option("--response", o->images.response, "--images, --source: camera response JSON (default: sRGB)");
+  cmd->add_option("--vignetting", o->images.vignetting_a, "--images, --source: vignetting gain 1 + a r^2 + b r^4, the a term");
+  cmd->add_option("--vignetting-b", o->images.vignetting_b, "--images, --source: vignetting, the b term");
+  cmd->add_option("--tracker-noise-deg", o->images.tracker_noise_deg,
+                  "--images, --source: RMS error of the poses' rotations (the refinement's prior)")
+      ->capture_default_str();
+  cmd->add_option("--out", o->out.out, "Output map (OpenEXR, float RGB)");
+  cmd->add_option("--width", o->out.width, "Map width in pixels (height = width / 2)")->capture_default_str();
+  cmd->add_flag("--no-refine", o->out.no_refine, "Use the tracker's rotations as they are");
+  cmd->add_flag("--no-fill", o->out.no_fill, "Leave uncovered pixels black instead of filling them");
+  cmd->add_option("--coverage", o->out.coverage, "Write a coverage map (PNG): magenta holes, grey by frame count");
+  cmd->add_option("--preview", o->out.preview, "Write a tone-mapped contact sheet (PNG) at -4, 0, +4 stops");
+  cmd->add_option("--corrections", o->out.corrections, "Write each frame's refined rotation and correction (CSV)");
+  cmd->add_option("--reference", o->out.reference,
+                  "Compare the result with this map (default: a synthetic recording's source map)");
+  cmd->add_option("--camera", o->camera, "Camera calibration (OpenCV YAML); --recording: instead of the session's");
+  cmd->add_option("--azimuth-offset", o->out.azimuth_offset_deg, "Azimuth offset of the map about +Y, degrees");
+  cmd->add_option("--export-images", o->export_images,
+                  "--recording: also write its frames and tracked poses as an --images folder (new)");
+  add_live_envmap_options(cmd, o->live);
   add_action(cmd, [o] { run_envmap(*o); });
 }
 

@@ -1,6 +1,7 @@
 #include "live_inputs.h"
 
 #include <filesystem>
+#include <fstream>
 
 #include "lumar/calib/camera_file.h"
 #include "lumar/capture/capture_thread.h"
@@ -82,6 +83,21 @@ CameraIntrinsics live_camera(const LiveInputOptions& o, int width, int height) {
   c.cx = width / 2.0;
   c.cy = height / 2.0;
   return c;
+}
+
+tracking::Rig live_rig(const std::string& session_json, double latency_ms) {
+  tracking::Rig rig;
+  rig.latency = seconds_to_nanos(latency_ms * 1e-3);
+  if (session_json.empty()) return rig;
+  std::ifstream in(session_json);
+  if (!in) throw InputError(session_json + ": cannot read the rig's session.json");
+  nlohmann::json j;
+  try {
+    j = nlohmann::json::parse(in);
+  } catch (const std::exception& e) {
+    throw InputError(session_json + ": malformed JSON (" + e.what() + ")");
+  }
+  return capture::session_from_json(j, session_json).rig;
 }
 
 nlohmann::json live_session(const LiveInputOptions& o, const CameraIntrinsics& camera,

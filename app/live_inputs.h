@@ -9,6 +9,7 @@
 
 #include "lumar/capture/frame_source.h"
 #include "lumar/core/camera.h"
+#include "lumar/tracking/rig.h"
 #include "lumar/tracking/tracker_driver.h"
 
 namespace lumar::app {
@@ -45,6 +46,10 @@ std::unique_ptr<tracking::TrackerDriver> make_tracker_driver(const LiveInputOpti
 // Intrinsics from --camera, or a nominal pinhole (focal length = width, no distortion)
 // for a frame size, flagged as such in the session.
 CameraIntrinsics live_camera(const LiveInputOptions& o, int width, int height);
+
+// The rig to pair frames with poses: the "rig" of a session.json, or (empty path) the
+// identity with --latency-ms. InputError naming the file when it cannot be read.
+tracking::Rig live_rig(const std::string& session_json, double latency_ms);
 
 // session.json content for a recording of these inputs (camera, tracker, rig).
 nlohmann::json live_session(const LiveInputOptions& o, const CameraIntrinsics& camera,

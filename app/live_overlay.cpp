@@ -2,14 +2,11 @@
 
 #include <spdlog/spdlog.h>
 
-#include <fstream>
-#include <nlohmann/json.hpp>
 #include <thread>
 
 #include "lumar/calib/undistortion.h"
 #include "lumar/capture/capture_thread.h"
 #include "lumar/capture/frame_pose_pairing.h"
-#include "lumar/capture/session.h"
 #include "lumar/core/compositor.h"
 #include "lumar/core/error.h"
 #include "lumar/core/gl/context.h"
@@ -18,29 +15,10 @@
 
 namespace lumar::app {
 
-namespace {
-
-tracking::Rig load_rig(const LiveOverlayOptions& o) {
-  tracking::Rig rig;
-  rig.latency = seconds_to_nanos(o.in.latency_ms * 1e-3);
-  if (o.rig.empty()) return rig;
-  std::ifstream in(o.rig);
-  if (!in) throw InputError(o.rig.string() + ": cannot read the rig's session.json");
-  nlohmann::json j;
-  try {
-    j = nlohmann::json::parse(in);
-  } catch (const std::exception& e) {
-    throw InputError(o.rig.string() + ": malformed JSON (" + e.what() + ")");
-  }
-  return capture::session_from_json(j, o.rig.string()).rig;
-}
-
-}  // namespace
-
 void run_live_overlay(const LiveOverlayOptions& o) {
   if (o.scene.empty()) throw InputError("overlay: the live path needs --scene");
   const Scene scene = load_scene(o.scene);
-  const tracking::Rig rig = load_rig(o);
+  const tracking::Rig rig = live_rig(o.rig.string(), o.in.latency_ms);
   LiveSource live = open_live_source(o.in);
   const cv::Size size = live.source->frame_size();
   const CameraIntrinsics camera = live_camera(o.in, size.width, size.height);

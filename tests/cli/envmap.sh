@@ -70,4 +70,287 @@ case_synth_sweep_bad_exposures() {
     --exposures 0,x
 }
 
+# --- lumar envmap --images: a folder of images with a poses CSV ---
+
+# A recording's frames and tracked poses as an --images folder ($2), via --export-images.
+export_images() {
+  "$LUMAR" envmap --recording "$1" --export-images "$2" --no-refine >"$TMP/export.log" 2>&1 \
+    || { cat "$TMP/export.log"; fail "envmap --export-images failed"; }
+}
+
+# The median relative luminance error (percent) an envmap log reports against its reference.
+reported_error() { sed -n 's/.*median relative luminance error \([0-9.]*\) %.*/\1/p' "$1"; }
+
+vignetting_of() {  # recording -> "--vignetting A --vignetting-b B"
+  python3 -c "import json; v=json.load(open('$1/session.json'))['radiometry']['vignetting']; print('--vignetting %r --vignetting-b %r' % (v[0], v[1]))"
+}
+
+case_images_with_poses_match_the_recording() {
+  # 20 stations of 3 exposures; the same frames and tracked rotations stitched from the
+  # recording and from exported PNGs + poses.csv (brackets as stations) must give the
+  # same map: same refinement, same error against the source map, <= 5 %.
+  "$LUMAR" synth --sweep --envmap "$MAP" --camera "$CAM" --out "$TMP/rec" --frames 60 --supersample 1 \
+    --exposures 4,-1,-6 --tracker-noise-deg 0.75 --codec ffv1 >"$TMP/synth.log" 2>&1 \
+    || { cat "$TMP/synth.log"; fail "synth --sweep failed"; }
+  export_images "$TMP/rec" "$TMP/img"
+  [ "$(ls "$TMP/img"/frame-*.png | wc -l)" -eq 60 ] || fail "expected 60 exported frames"
+  head -1 "$TMP/img/poses.csv" | grep -qx "file,qw,qx,qy,qz,x,y,z,exposure,station" || fail "unexpected poses.csv header"
+  "$LUMAR" envmap --recording "$TMP/rec" --out "$TMP/rec.exr" --width 256 >"$TMP/rec.log" 2>/dev/null \
+    || { cat "$TMP/rec.log"; fail "envmap --recording failed"; }
+  # shellcheck disable=SC2046
+  "$LUMAR" envmap --images "$TMP/img" --poses "$TMP/img/poses.csv" --camera "$TMP/img/camera.yml" \
+    $(vignetting_of "$TMP/rec") --reference "$MAP" --out "$TMP/img.exr" --width 256 --coverage "$TMP/img.png" \
+    --corrections "$TMP/corr.csv" >"$TMP/img.log" 2>"$TMP/progress.log" \
+    || { cat "$TMP/img.log" "$TMP/progress.log"; fail "envmap --images failed"; }
+  cat "$TMP/rec.log" "$TMP/img.log"
+  [ -s "$TMP/img.exr" ] && [ -s "$TMP/img.png" ] || fail "envmap --images wrote no map or coverage"
+  grep -q "^stitching" "$TMP/progress.log" || fail "no progress on stderr"
+  [ "$(grep -c '^frame-' "$TMP/corr.csv")" -eq 60 ] || fail "expected 60 corrections named by file"
+  local a b
+  a=$(reported_error "$TMP/rec.log")
+  b=$(reported_error "$TMP/img.log")
+  [ -n "$a" ] && [ -n "$b" ] || fail "no error against the source map reported"
+  awk -v a="$a" -v b="$b" 'BEGIN { d = a - b; exit !(d * d <= 0.01 && b <= 5) }' \
+    || fail "images path error $b % vs recording path $a % (expected equal within 0.1 and <= 5 %)"
+  grep -o 'refined.*' "$TMP/rec.log" | sed 's/;.*//' >"$TMP/a" && grep -o 'refined.*' "$TMP/img.log" | sed 's/;.*//' >"$TMP/b"
+  diff "$TMP/a" "$TMP/b" || fail "the refinement differs between the two inputs"
+}
+
+# A 6-frame sweep exported as images, for the bad-input cases.
+small_images() {
+  small_sweep "$TMP/rec"
+  export_images "$TMP/rec" "$TMP/img"
+}
+
+images_envmap() {  # extra args...
+  "$LUMAR" envmap --images "$TMP/img" --poses "$TMP/poses.csv" --camera "$CAM" --out "$TMP/map.exr" --width 64 "$@"
+}
+
+case_images_bad_input() {
+  small_images
+  # A row for an image that does not exist.
+  { cat "$TMP/img/poses.csv"; echo "frame-000099.png,1,0,0,0,0,1.5,0,1,9"; } >"$TMP/poses.csv"
+  expect_bad_input "frame-000099.png" "$TMP/map.exr" -- images_envmap
+  # A row for a file the glob leaves out.
+  cp "$TMP/img/poses.csv" "$TMP/poses.csv"
+  expect_bad_input "frame-000005.png" "$TMP/map.exr" -- "$LUMAR" envmap --images "$TMP/img/frame-00000[0-4].png" \
+    --poses "$TMP/poses.csv" --camera "$CAM" --out "$TMP/map.exr" --width 64
+  # An image without a row.
+  sed '$d' "$TMP/img/poses.csv" >"$TMP/poses.csv"
+  expect_bad_input "frame-000005.png" "$TMP/map.exr" -- images_envmap
+  # A quaternion that is not unit length, and one that is not a number.
+  awk -F, -v OFS=, 'NR == 3 { $2 = 2 * $2 + 0.5 } 1' "$TMP/img/poses.csv" >"$TMP/poses.csv"
+  expect_bad_input "poses.csv:3" "$TMP/map.exr" -- images_envmap
+  awk -F, -v OFS=, 'NR == 4 { $3 = "nan" } 1' "$TMP/img/poses.csv" >"$TMP/poses.csv"
+  expect_bad_input "poses.csv:4" "$TMP/map.exr" -- images_envmap
+  # An image of another size than the calibration (a 320x240 PNG in place of the first frame).
+  cp "$TMP/img/poses.csv" "$TMP/poses.csv"
+  python3 -c "import struct,zlib
+w,h=320,240
+raw=b''.join(b'\0'+b'\x80'*(3*w) for _ in range(h))
+def chunk(k,d): return struct.pack('>I',len(d))+k+d+struct.pack('>I',zlib.crc32(k+d)&0xffffffff)
+open('$TMP/img/frame-000000.png','wb').write(b'\x89PNG\r\n\x1a\n'+chunk(b'IHDR',struct.pack('>IIBBBBB',w,h,8,2,0,0,0))+chunk(b'IDAT',zlib.compress(raw))+chunk(b'IEND',b''))"
+  expect_bad_input "320x240" "$TMP/map.exr" -- images_envmap
+  # A reference map that does not exist (checked before anything is written).
+  expect_bad_input "$TMP/nowhere.exr" "$TMP/map.exr" -- images_envmap --reference "$TMP/nowhere.exr"
+}
+
+# --- lumar envmap --source: a live sweep, stitched as it goes ---
+
+# OpenEXR magic number: the file is a whole EXR (outputs are renamed into place complete).
+is_exr() { [ "$(od -An -tx1 -N4 "$1" | tr -d ' ')" = "762f3101" ]; }
+no_leftovers() { [ -z "$(find "$TMP" -maxdepth 1 -name '*.tmp' -o -maxdepth 1 -name '.*partial*')" ]; }
+
+case_live_recording_reconstructs_the_map() {
+  # A recorded sweep (20 stations of 3 exposures, 0.75 deg tracker noise) played in real
+  # time through the live path, paired with its own tracker stream: tracker rotations,
+  # no refinement. The map is rewritten while it runs, coverage grows, and the final map
+  # is within 6 % (median relative luminance, covered pixels) of the source map, as
+  # close as `--recording --no-refine` gets; --refine-at-end then gets what `--recording` gets.
+  "$LUMAR" synth --sweep --envmap "$MAP" --camera "$CAM" --out "$TMP/rec" --frames 60 --supersample 1 \
+    --exposures 4,-1,-6 --tracker-noise-deg 0.75 --codec ffv1 >"$TMP/synth.log" 2>&1 \
+    || { cat "$TMP/synth.log"; fail "synth --sweep failed"; }
+  "$LUMAR" envmap --source "recording:$TMP/rec" --out "$TMP/live.exr" --width 256 --update-every 1 \
+    --coverage "$TMP/live.png" --refine-at-end --corrections "$TMP/corr.csv" >"$TMP/live.log" 2>&1 \
+    || { cat "$TMP/live.log"; fail "live envmap failed"; }
+  cat "$TMP/live.log"
+  is_exr "$TMP/live.exr" || fail "no EXR written"
+  [ -s "$TMP/live.png" ] || fail "no coverage PNG written"
+  no_leftovers || fail "temporary files left behind"
+  local updates first last err
+  updates=$(grep -c "updated $TMP/live.exr" "$TMP/live.log")
+  [ "$updates" -ge 3 ] || fail "expected the map rewritten at least 3 times while running, got $updates"
+  first=$(grep "updated" "$TMP/live.log" | head -1 | sed 's/.*, \([0-9.]*\) % covered.*/\1/')
+  last=$(grep "updated" "$TMP/live.log" | tail -1 | sed 's/.*, \([0-9.]*\) % covered.*/\1/')
+  awk -v a="$first" -v b="$last" 'BEGIN { exit !(b > a + 20) }' || fail "coverage did not grow: $first % -> $last %"
+  grep -q "60 frames, 60 stitched" "$TMP/live.log" || fail "expected all 60 frames stitched"
+  err=$(reported_error "$TMP/live.log" | head -1)
+  [ -n "$err" ] || fail "no error against the source map reported"
+  # The offline path with the same (unrefined) rotations stitches the same map.
+  "$LUMAR" envmap --recording "$TMP/rec" --no-refine --out "$TMP/offline.exr" --width 256 >"$TMP/offline.log" 2>&1 \
+    || { cat "$TMP/offline.log"; fail "envmap --recording failed"; }
+  local offline
+  offline=$(reported_error "$TMP/offline.log")
+  echo "offline, same rotations: $offline %"
+  awk -v e="$err" -v x="$offline" 'BEGIN { d = e - x; exit !(e <= 6 && d * d <= 0.0025) }' \
+    || fail "live map is $err % off the source map, expected <= 6 % and within 0.05 of the offline $offline %"
+  # --refine-at-end: the kept frames through the offline pipeline, as `--recording` does.
+  [ "$(grep -c '^[0-9]' "$TMP/corr.csv")" -eq 60 ] || fail "expected 60 corrections after the sweep"
+  "$LUMAR" envmap --recording "$TMP/rec" --out "$TMP/refined.exr" --width 256 >"$TMP/refined.log" 2>&1 \
+    || { cat "$TMP/refined.log"; fail "envmap --recording failed"; }
+  local refined offline_refined
+  refined=$(reported_error "$TMP/live.log" | tail -1)
+  offline_refined=$(reported_error "$TMP/refined.log")
+  echo "refined at the end: $refined %, offline refined: $offline_refined %"
+  awk -v e="$refined" -v x="$offline_refined" -v l="$err" 'BEGIN { d = e - x; exit !(e < l && d * d <= 0.0025) }' \
+    || fail "refined live map $refined %, expected below the live $err % and within 0.05 of the offline $offline_refined %"
+}
+
+# The true T_transmitter_sensor of frame K of a synthetic recording: the rig undone from
+# truth.csv's T_world_camera, as "x,y,z,qw,qx,qy,qz" (the emulator's trajectory columns).
+true_sensor_pose() {  # recording frame
+  python3 - "$1" "$2" <<'PY'
+import csv, json, sys
+rig = json.load(open(sys.argv[1] + '/session.json'))['rig']
+def mul(a, b):
+    w1, x1, y1, z1 = a; w2, x2, y2, z2 = b
+    return (w1*w2 - x1*x2 - y1*y2 - z1*z2, w1*x2 + x1*w2 + y1*z2 - z1*y2,
+            w1*y2 - x1*z2 + y1*w2 + z1*x2, w1*z2 + x1*y2 - y1*x2 + z1*w2)
+def conj(q): return (q[0], -q[1], -q[2], -q[3])
+def rotate(q, v): return mul(mul(q, (0.0,) + tuple(v)), conj(q))[1:]
+def inverse(T):
+    q, t = T; qi = conj(q)
+    return (qi, tuple(-c for c in rotate(qi, t)))
+def compose(A, B):  # A * B
+    return (mul(A[0], B[0]), tuple(a + b for a, b in zip(rotate(A[0], B[1]), A[1])))
+pose = lambda j: (tuple(j['rotation_wxyz']), tuple(j['translation']))
+row = [r for r in csv.DictReader(open(sys.argv[1] + '/truth.csv')) if r['index'] == sys.argv[2]][0]
+T_wc = (tuple(float(row[k]) for k in 'qw qx qy qz'.split()), tuple(float(row[k]) for k in 'xyz'))
+q, t = compose(compose(inverse(pose(rig['T_world_transmitter'])), T_wc), inverse(pose(rig['T_sensor_camera'])))
+print('1,%.9f,%.9f,%.9f,%.12f,%.12f,%.12f,%.12f' % (t + q))
+PY
+}
+
+# A camera that stands still at the sweep's first bracket, then turns to its third and
+# stands still again: the two brackets' frames (exposures alternating) as an image
+# sequence with a timestamp table, N frames at 20 fps from 0 s and N more from 4.5 s;
+# the emulator replays the sensor's true pose at each bracket, held from 0 to 4 s and
+# from 4.1 s on. The unknown gap between the emulator's start and the first frame (the
+# tracker connecting, the command starting) may be up to 3 s without a frame getting the
+# other bracket's pose.
+two_station_camera() {  # frames per station [start of the second station's frames, ms (default 4500)]
+  local second=${2:-4500}
+  small_images
+  mkdir "$TMP/still"
+  echo "file,time_ns" >"$TMP/still-times.csv"
+  local i name
+  for i in $(seq 0 $((2 * $1 - 1))); do
+    name=$(printf "f-%03d.png" "$i")
+    if [ "$i" -lt "$1" ]; then
+      cp "$TMP/img/frame-00000$((i % 2)).png" "$TMP/still/$name"
+      echo "$name,$((i * 50000000))" >>"$TMP/still-times.csv"
+    else
+      cp "$TMP/img/frame-00000$((4 + i % 2)).png" "$TMP/still/$name"
+      echo "$name,$((second * 1000000 + (i - $1) * 50000000))" >>"$TMP/still-times.csv"
+    fi
+  done
+  # The sensor's true pose in the transmitter frame at the first and third bracket.
+  local a b
+  a=$(true_sensor_pose "$TMP/rec" 0)
+  b=$(true_sensor_pose "$TMP/rec" 4)
+  [ -n "$a" ] && [ -n "$b" ] || fail "no true poses for the brackets"
+  printf "time_ns,station,x,y,z,qw,qx,qy,qz\n0,%s\n4000000000,%s\n4100000000,%s\n9000000000,%s\n" "$a" "$a" "$b" "$b" \
+    >"$TMP/still.csv"
+  EXPOSURES=$(awk -F, 'NR == 2 || NR == 3 { printf "%s%s", sep, $9; sep = "," }' "$TMP/img/poses.csv")
+  start_emulator --trajectory "$TMP/still.csv" --orientation-noise-deg 0 --position-noise-m 0
+  # shellcheck disable=SC2207
+  LIVE_STILL=(envmap --source "images:$TMP/still" --timestamps "$TMP/still-times.csv" --tracker "serial:$TMP/tty"
+    --rig "$TMP/rec/session.json" --camera "$CAM" $(vignetting_of "$TMP/rec") --frame-exposure "$EXPOSURES"
+    --out "$TMP/live.exr" --width 256)
+}
+
+live_still() {  # extra args...
+  "$LUMAR" "${LIVE_STILL[@]}" "$@"
+}
+
+case_live_tracker_two_stations() {
+  # Frames paired with the emulator's poses over the serial driver (rig and latency of
+  # the recording): two brackets' views, together about 13 % of the sphere, within 3 %
+  # of the source map there, as close as the same frames with their true rotations
+  # stitched through --images; the map is written after the first view, then grows.
+  two_station_camera 20
+  # A loaded machine delays the tracker's reader thread: let frames wait longer for it.
+  live_still --update-every 0.5 --max-wait-ms 500 --reference "$MAP" >"$TMP/live.log" 2>&1 || { cat "$TMP/live.log"; fail "live envmap failed"; }
+  cat "$TMP/live.log"
+  is_exr "$TMP/live.exr" || fail "no EXR written"
+  local stitched first covered err
+  stitched=$(sed -n 's/.*40 frames, \([0-9]*\) stitched.*/\1/p' "$TMP/live.log")
+  [ "${stitched:-0}" -ge 30 ] || fail "expected at least 30 of 40 frames stitched, got ${stitched:-none}"
+  first=$(grep "updated" "$TMP/live.log" | head -1 | sed 's/.*, \([0-9.]*\) % covered.*/\1/')
+  # Reference: the same four frames with their true rotations through --images.
+  mkdir "$TMP/four"
+  echo "file,qw,qx,qy,qz,exposure" >"$TMP/four.csv"
+  for i in 0 1 4 5; do
+    cp "$TMP/img/frame-00000$i.png" "$TMP/four/"
+    echo "frame-00000$i.png,$(awk -F, -v k="$i" '$1 == k { print $6 "," $7 "," $8 "," $9 }' "$TMP/rec/truth.csv"),$(sed -n "$((i + 2))p" "$TMP/img/poses.csv" | cut -d, -f9)" >>"$TMP/four.csv"
+  done
+  "$LUMAR" envmap --images "$TMP/four" --poses "$TMP/four.csv" --camera "$CAM" $(vignetting_of "$TMP/rec") --no-refine \
+    --reference "$MAP" --out "$TMP/four.exr" --width 256 >"$TMP/four.log" 2>&1 || { cat "$TMP/four.log"; fail "--images failed"; }
+  local expected
+  expected=$(reported_error "$TMP/four.log")
+  echo "the same frames with true rotations through --images: $expected %"
+  covered=$(grep "updated" "$TMP/live.log" | tail -1 | sed 's/.*, \([0-9.]*\) % covered.*/\1/')
+  awk -v c="$first" 'BEGIN { exit !(c >= 5 && c <= 9) }' || fail "first map covers $first %, expected one view (5-9 %)"
+  awk -v c="$covered" 'BEGIN { exit !(c >= 10 && c <= 18) }' || fail "coverage $covered %, expected two views (10-18 %)"
+  err=$(reported_error "$TMP/live.log")
+  awk -v e="${err:-100}" -v x="$expected" 'BEGIN { d = e - x; exit !(e <= 3 && d * d <= 0.25) }' \
+    || fail "live map is ${err:-?} % off the source map, expected <= 3 % and within 0.5 of $expected %"
+}
+
+case_live_stops_cleanly_on_sigint() {
+  two_station_camera 80
+  "$LUMAR" "${LIVE_STILL[@]}" --update-every 0.3 >"$TMP/live.log" 2>&1 &
+  local pid=$!
+  PIDS+=("$pid")
+  wait_for 20 grep -q "updated" "$TMP/live.log" || { cat "$TMP/live.log"; fail "no map written while running"; }
+  is_exr "$TMP/live.exr" || fail "the map written while running is not an EXR"
+  kill -INT "$pid"
+  wait_for 5 eval '! kill -0 '"$pid"' 2>/dev/null' || fail "envmap did not stop within 5 s of SIGINT"
+  wait "$pid" || { cat "$TMP/live.log"; fail "envmap exited with an error after SIGINT"; }
+  cat "$TMP/live.log"
+  grep -q "^envmap: 200 frames" "$TMP/live.log" && fail "SIGINT did not stop the sweep early"
+  is_exr "$TMP/live.exr" || fail "no EXR after SIGINT"
+  no_leftovers || fail "temporary files left behind"
+}
+
+case_live_tracker_vanishes() {
+  # The tracker is unplugged mid-sweep: one line says so, the sweep goes on without
+  # stitching, and the map written before stays.
+  two_station_camera 20 1000
+  "$LUMAR" "${LIVE_STILL[@]}" --update-every 0.3 >"$TMP/live.log" 2>&1 &
+  local pid=$!
+  PIDS+=("$pid")
+  wait_for 20 grep -q "updated" "$TMP/live.log" || { cat "$TMP/live.log"; fail "no map written while running"; }
+  kill -9 "$EMULATOR"
+  wait "$pid" || { cat "$TMP/live.log"; fail "envmap failed when the tracker vanished"; }
+  cat "$TMP/live.log"
+  [ "$(grep -c "tracker lost" "$TMP/live.log")" -eq 1 ] || fail "expected exactly one 'tracker lost' line"
+  grep -q "without a pose" "$TMP/live.log" || fail "no summary"
+  is_exr "$TMP/live.exr" || fail "no EXR kept"
+}
+
+case_live_bad_input() {
+  small_images
+  expect_bad_input "a live sweep needs --tracker" "$TMP/map.exr" -- "$LUMAR" envmap --source "images:$TMP/img" \
+    --images-fps 10 --out "$TMP/map.exr"
+  expect_bad_input "/dev/lumar-no-such-port" "$TMP/map.exr" -- "$LUMAR" envmap --source "images:$TMP/img" \
+    --images-fps 10 --tracker serial:/dev/lumar-no-such-port --out "$TMP/map.exr"
+  expect_bad_input "serial:/dev/null" "$TMP/map.exr" -- "$LUMAR" envmap --source "images:$TMP/img" \
+    --images-fps 10 --tracker serial:/dev/null --tracker-timeout 1 --out "$TMP/map.exr"
+  expect_bad_input "exactly one of" "$TMP/map.exr" -- "$LUMAR" envmap --source "images:$TMP/img" \
+    --recording "$TMP/rec" --out "$TMP/map.exr"
+  expect_bad_input "$TMP/nowhere" "$TMP/map.exr" -- "$LUMAR" envmap --source "video:$TMP/nowhere.mkv" \
+    --tracker serial:/dev/null --out "$TMP/map.exr"
+}
+
 run_case
