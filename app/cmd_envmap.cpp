@@ -20,7 +20,6 @@ namespace {
 struct EnvmapOptions {
   EnvmapOutputOptions out;
   std::string recording, export_images;
-  std::string camera;  // --recording: instead of the session's; --images: required
   ImagesInputOptions images;
   LiveEnvmapOptions live;
 };
@@ -128,7 +127,6 @@ void run_envmap(EnvmapOptions& o) {
     if (!o.out.corrections.empty() && !o.live.refine_at_end)
       throw InputError("--corrections: a live sweep is refined only with --refine-at-end");
     o.live.out = o.out;
-    o.live.in.camera_file = o.camera;
     o.live.response = o.images.response;
     o.live.vignetting_a = o.images.vignetting_a;
     o.live.vignetting_b = o.images.vignetting_b;
@@ -138,9 +136,9 @@ void run_envmap(EnvmapOptions& o) {
   }
   SweepInput in;
   if (!o.recording.empty()) {
-    in = recording_sweep_input(o.recording, o.camera, o.out.width);
+    in = recording_sweep_input(o.recording, o.live.in.camera_file, o.out.width);
   } else {
-    o.images.camera = o.camera;
+    o.images.camera = o.live.in.camera_file;
     in = images_sweep_input(o.images, o.out.width);
   }
   if (o.out.azimuth_offset_deg) in.stitch.azimuth_offset_deg = *o.out.azimuth_offset_deg;
@@ -177,7 +175,6 @@ void register_envmap(CLI::App& app) {
   cmd->add_option("--corrections", o->out.corrections, "Write each frame's refined rotation and correction (CSV)");
   cmd->add_option("--reference", o->out.reference,
                   "Compare the result with this map (default: a synthetic recording's source map)");
-  cmd->add_option("--camera", o->camera, "Camera calibration (OpenCV YAML); --recording: instead of the session's");
   cmd->add_option("--azimuth-offset", o->out.azimuth_offset_deg, "Azimuth offset of the map about +Y, degrees");
   cmd->add_option("--export-images", o->export_images,
                   "--recording: also write its frames and tracked poses as an --images folder (new)");

@@ -21,20 +21,10 @@ void add_live_envmap_options(CLI::App* cmd, LiveEnvmapOptions& o) {
   cmd->add_option("--source", in.source,
                   "Live sweep: video:FILE | images:DIR_OR_GLOB | v4l2:/dev/videoN | recording:DIR (files play in "
                   "real time)");
-  cmd->add_option("--tracker", in.tracker, "--source: tracker on a serial port, e.g. serial:/dev/ttyUSB0");
-  cmd->add_option("--tracker-device", in.tracker_model, "--source: isotrak2 or fastrak")->capture_default_str();
-  cmd->add_option("--baud", in.baud, "--source: tracker line speed")->capture_default_str();
-  cmd->add_option("--latency-ms", in.latency_ms, "--source: tracker device latency, subtracted from pose times")
-      ->capture_default_str();
   cmd->add_option("--rig", o.rig, "--source: a session.json whose rig (tracker to camera) to use (default: identity)");
-  cmd->add_option("--timestamps", in.timestamps, "--source images: a file,time_ns table of the frames");
-  cmd->add_option("--images-fps", in.images_fps, "--source images: fixed frame rate when there is no table");
-  cmd->add_option("--video-width", in.width, "--source v4l2: frame width to ask for")->capture_default_str();
-  cmd->add_option("--video-height", in.height, "--source v4l2: frame height to ask for")->capture_default_str();
-  cmd->add_option("--camera-fps", in.camera_fps, "--source v4l2: frame rate to ask for")->capture_default_str();
-  cmd->add_option("--format", in.pixel_format, "--source v4l2: pixel format (YUYV or MJPG)");
-  cmd->add_option("--v4l2-exposure", in.exposure_100us, "--source v4l2: exposure in 100 us units (default: leave)");
-  cmd->add_option("--gain", in.gain, "--source v4l2: sensor gain (default: leave)");
+  add_live_input_options(cmd, in,
+                         "Camera calibration (OpenCV YAML): --images needs it; --recording: instead of the session's; "
+                         "--source: default a nominal pinhole");
   cmd->add_option("--frame-exposure", o.exposures,
                   "--source: video linear value per unit radiance; a list E1,E2,... is cycled over the frames (a "
                   "recording: its own)")

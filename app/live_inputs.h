@@ -30,7 +30,9 @@ struct LiveInputOptions {
   std::string camera_file;       // OpenCV YAML intrinsics (empty: nominal pinhole)
 };
 
-void add_live_input_options(CLI::App* cmd, LiveInputOptions& o);
+// The options of LiveInputOptions except the source, with the same names in every command.
+void add_live_input_options(CLI::App* cmd, LiveInputOptions& o,
+                            const std::string& camera_help = "Camera calibration (OpenCV YAML); default: a nominal pinhole");
 
 struct LiveSource {
   std::unique_ptr<capture::FrameSource> source;  // CLOCK_MONOTONIC times (files are played in real time)
