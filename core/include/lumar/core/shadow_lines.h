@@ -5,17 +5,18 @@
 // unshadowed irradiance, per RGB channel. A virtual object that blocks a line removes
 // that fraction: attenuation = E_with / E_without = 1 - sum of blocked fractions.
 //
-// Lines are grouped for culling (Gibson et al. 2003): receivers into clusters of nearby
-// points, emitter patches into a binary tree; lines of one (receiver cluster, patch)
-// pair are contiguous. Lines below a significance are dropped, but their energy stays in
-// E_without, so the ratio stays exact up to the dropped share (at most
-// ShadowLineOptions::max_dropped_fraction per receiver).
+// Lines are grouped for culling: by emitter sample point (a pencil of lines meeting at
+// it), then by receiver in the order of the receiver grids (shadow_receiver_grid.h), so a
+// run of receivers in one grid row is a run of lines. Lines below a significance are
+// dropped, but their energy stays in E_without, so the ratio stays exact up to the
+// dropped share (at most ShadowLineOptions::max_dropped_fraction per receiver).
 #include <cstdint>
 #include <glm/glm.hpp>
 #include <vector>
 
 #include "lumar/core/ray_scene.h"
 #include "lumar/core/shadow_emitters.h"
+#include "lumar/core/shadow_receiver_grid.h"
 
 namespace lumar {
 
@@ -25,21 +26,10 @@ struct ShadowLine {
   glm::vec3 fraction{0.0f};    // share of the receiver's E_without carried, per channel
 };
 
-// A node of a bounding-sphere tree. Receiver nodes bound receiver points; emitter nodes
-// bound sample points, or, for a distant map, hold the mean direction (centre) and the
-// largest distance of a unit direction from it (radius).
-struct ShadowTreeNode {
-  glm::vec3 centre{0.0f};
-  float radius = 0.0f;
-  std::int32_t child[2] = {-1, -1};
-  std::int32_t leaf = -1;  // receiver cluster index, or patch index
-};
-
 struct ShadowLineOptions {
   // Largest share of a receiver's irradiance that may be dropped as insignificant lines
   // (the smallest lines go first); bounds the error this adds to the attenuation.
   double max_dropped_fraction = 0.002;
-  int receivers_per_cluster = 16;
 };
 
 struct ShadowLines {
@@ -47,17 +37,14 @@ struct ShadowLines {
   std::vector<glm::vec3> origins;        // shadow ray origins (receiver points nudged along their normal)
   std::vector<EmitterPoint> samples;     // line ends (emitter sample points)
   std::uint32_t patch_count = 0;
-  std::vector<ShadowTreeNode> receiver_tree, emitter_tree;  // roots at index 0
-  std::vector<std::uint32_t> cluster_receivers;  // receivers ordered by cluster
-  std::vector<std::uint32_t> cluster_first;      // cluster c: cluster_receivers[first[c], first[c+1])
-  std::vector<ShadowLine> lines;                 // grouped by (cluster, patch)
-  std::vector<std::uint32_t> block_first;        // pair (c, p) at c * patch_count + p; size clusters*patches+1
+  ReceiverGrids grids;                           // over the origins
+  std::vector<ShadowLine> lines;                 // by sample, then by receiver in grids.order
+  std::vector<std::uint32_t> sample_first;       // sample s: lines[sample_first[s], sample_first[s+1])
   std::vector<glm::vec3> unshadowed;             // E_without per receiver (with proxy visibility), RGB
   std::vector<float> dropped;                    // share of E_without dropped per receiver (luminance-weighted max channel)
   std::size_t candidate_lines = 0;               // lines with non-zero transfer before dropping
 
   std::size_t receiver_count() const { return origins.size(); }
-  std::size_t cluster_count() const { return cluster_first.empty() ? 0 : cluster_first.size() - 1; }
   // End point of a line (distant: kDistantLineLength away along the sample's direction).
   glm::vec3 line_end(const ShadowLine& l) const {
     return emitter_line_end(samples[l.sample], distant, origins[l.receiver]);
