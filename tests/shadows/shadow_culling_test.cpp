@@ -15,6 +15,7 @@
 #include "lumar/core/shadow_occlusion.h"
 #include "lumar/core/shadow_receiver_grid.h"
 #include "shadow_test_util.h"
+#include "sample_room_lines.h"
 #include "test_paths.h"
 
 namespace lumar {
@@ -155,14 +156,16 @@ std::size_t check_pose(LineShadows& shadows, const glm::dmat4& T, const char* wh
   return blocked.size();
 }
 
+// The emitter sample point with the most flux: lines to it shadow the most.
+const EmitterPoint& brightest_sample(const ShadowLines& lines) {
+  return *std::max_element(lines.samples.begin(), lines.samples.end(),
+                           [](const EmitterPoint& a, const EmitterPoint& b) { return a.flux.g < b.flux.g; });
+}
+
 TEST(ShadowCulling, CandidatesContainEveryBlockedLine) {
-  Scene s = load_scene(test::source_dir() / "data/scenes/room/scene.json");
-  s.shadows.receiver_vertices = 900;
-  const ShadowScene scene(s);
-  const Mesh rec = scene.receivers();
-  const Emitters e = scene.emitters(rec.positions, rec.normals);
-  LineShadows shadows(build_shadow_lines(rec.positions, rec.normals, e, scene.proxy()));
-  const auto& fig = scene.objects().at(0);
+  const test::SampleRoomLines room = test::sample_room_lines(900);
+  LineShadows shadows(room.lines);
+  const auto& fig = room.figurine();
   shadows.add_object(fig.model, fig.T_world_model);
   const auto [lo, hi] = fig.model.bounds();
   const glm::dvec3 model_centre = 0.5 * glm::dvec3(lo + hi);
@@ -182,6 +185,7 @@ TEST(ShadowCulling, CandidatesContainEveryBlockedLine) {
   std::uniform_real_distribution<double> u(0, 1);
   std::size_t blocked = 0;
   for (int k = 0; k < 12; ++k) {
+    const Scene& s = room.manifest;
     const glm::dvec3 at(s.movement_min.x + u(rng) * (s.movement_max.x - s.movement_min.x), 0.1 + 0.4 * u(rng),
                         s.movement_min.z + u(rng) * (s.movement_max.z - s.movement_min.z));
     glm::dmat4 T = pose(6.3 * u(rng), at);
@@ -190,10 +194,8 @@ TEST(ShadowCulling, CandidatesContainEveryBlockedLine) {
   }
   // Next to the brightest emitter point: the figurine's box centre 8-20 cm from it along
   // its normal (the point inside the box or just outside), and at it.
-  std::size_t brightest = 0;
-  for (std::size_t i = 0; i < e.samples.size(); ++i)
-    if (e.samples[i].flux.g > e.samples[brightest].flux.g) brightest = i;
-  const glm::dvec3 x(e.samples[brightest].position), n(e.samples[brightest].normal);
+  const EmitterPoint& brightest = brightest_sample(room.lines);
+  const glm::dvec3 x(brightest.position), n(brightest.normal);
   for (const double d : {0.08, 0.12, 0.2, 0.0}) {
     // d = 0: the emitter point inside the figurine's box.
     blocked += check_pose(shadows, pose(0.7, x + d * n), d == 0.0 ? "emitter inside the box" : "near an emitter");
@@ -202,13 +204,9 @@ TEST(ShadowCulling, CandidatesContainEveryBlockedLine) {
 }
 
 TEST(ShadowCulling, TwoObjectsCountEachBlockedLineOnce) {
-  Scene s = load_scene(test::source_dir() / "data/scenes/room/scene.json");
-  s.shadows.receiver_vertices = 900;
-  const ShadowScene scene(s);
-  const Mesh rec = scene.receivers();
-  const Emitters e = scene.emitters(rec.positions, rec.normals);
-  const ShadowLines lines = build_shadow_lines(rec.positions, rec.normals, e, scene.proxy());
-  const auto& fig = scene.objects().at(0);
+  const test::SampleRoomLines room = test::sample_room_lines(900);
+  const ShadowLines& lines = room.lines;
+  const auto& fig = room.figurine();
   const glm::dmat4 T_fig = glm::translate(glm::dmat4(1.0), glm::dvec3(0, 0.1, 0)) * fig.T_world_model;
   const auto [lo, hi] = fig.model.bounds();
   const glm::dvec3 centre(T_fig * glm::dvec4(0.5 * glm::dvec3(lo + hi), 1.0));
@@ -219,10 +217,8 @@ TEST(ShadowCulling, TwoObjectsCountEachBlockedLineOnce) {
   both.add_object(ball, glm::dmat4(1.0));
   ball_only.add_object(ball, glm::dmat4(1.0));
   fig_only.update();
-  std::size_t brightest = 0;
-  for (std::size_t i = 0; i < e.samples.size(); ++i)
-    if (e.samples[i].flux.g > e.samples[brightest].flux.g) brightest = i;
-  const glm::dvec3 towards = glm::normalize(glm::dvec3(e.samples[brightest].position) - centre);
+  const EmitterPoint& brightest = brightest_sample(room.lines);
+  const glm::dvec3 towards = glm::normalize(glm::dvec3(brightest.position) - centre);
   for (int k = 0; k < 3; ++k) {
     // The ball between the figurine and the brightest emitter point: many lines pass both.
     const glm::dmat4 T_ball = glm::translate(glm::dmat4(1.0), centre + (0.25 + 0.05 * k) * towards);

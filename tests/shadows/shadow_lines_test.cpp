@@ -15,6 +15,7 @@
 #include "lumar/core/shadow_occlusion.h"
 #include "lumar/core/shadow_receivers.h"
 #include "shadow_test_util.h"
+#include "sample_room_lines.h"
 #include "test_paths.h"
 
 namespace lumar {
@@ -90,13 +91,10 @@ TEST(ShadowEmitters, SunPatchIsResolvedAndThresholdKeepsIt) {
 }
 
 TEST(ShadowLines, EnergyAccountingIsExact) {
-  Scene s = load_scene(test::source_dir() / "data/scenes/room/scene.json");
-  s.shadows.receiver_vertices = 400;
-  const ShadowScene scene(s);
-  const Mesh rec = scene.receivers();
+  const test::SampleRoomLines room = test::sample_room_lines(400);
+  const Mesh& rec = room.receivers;
   ASSERT_GT(rec.positions.size(), 300u);
-  const Emitters e = scene.emitters(rec.positions, rec.normals);
-  const ShadowLines lines = build_shadow_lines(rec.positions, rec.normals, e, scene.proxy());
+  const ShadowLines& lines = room.lines;
   std::vector<glm::dvec3> kept(rec.positions.size(), glm::dvec3(0.0));
   for (const ShadowLine& l : lines.lines) kept[l.receiver] += glm::dvec3(l.fraction);
   std::size_t dark = 0;
@@ -129,13 +127,9 @@ TEST(ShadowLines, EnergyAccountingIsExact) {
 }
 
 TEST(ShadowOcclusion, CullingChangesNothingAndSkipsWhenStill) {
-  Scene s = load_scene(test::source_dir() / "data/scenes/room/scene.json");
-  s.shadows.receiver_vertices = 1600;
-  const ShadowScene scene(s);
-  const Mesh rec = scene.receivers();
-  const Emitters e = scene.emitters(rec.positions, rec.normals);
-  LineShadows shadows(build_shadow_lines(rec.positions, rec.normals, e, scene.proxy()));
-  const auto& fig = scene.objects().at(0);
+  const test::SampleRoomLines room = test::sample_room_lines(1600);
+  LineShadows shadows(room.lines);
+  const auto& fig = room.figurine();
   shadows.add_object(fig.model, fig.T_world_model);
   for (int step = 0; step < 4; ++step) {
     const glm::dmat4 T = glm::translate(glm::dmat4(1.0), glm::dvec3(-0.15 * step, 0.1, 0.1 * step)) * fig.T_world_model;

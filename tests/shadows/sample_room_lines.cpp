@@ -1,0 +1,18 @@
+#include "sample_room_lines.h"
+
+#include "test_paths.h"
+
+namespace lumar::test {
+
+SampleRoomLines sample_room_lines(int receiver_vertices) {
+  SampleRoomLines room;
+  room.manifest = load_scene(source_dir() / "data/scenes/room/scene.json");
+  room.manifest.shadows.receiver_vertices = receiver_vertices;
+  room.scene = std::make_unique<ShadowScene>(room.manifest);
+  room.receivers = room.scene->receivers();
+  const Emitters e = room.scene->emitters(room.receivers.positions, room.receivers.normals);
+  room.lines = build_shadow_lines(room.receivers.positions, room.receivers.normals, e, room.scene->proxy());
+  return room;
+}
+
+}  // namespace lumar::test
