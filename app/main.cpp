@@ -8,6 +8,14 @@
 #include "commands.h"
 #include "lumar/core/error.h"
 
+#if defined(__SANITIZE_THREAD__)
+#include <tbb/global_control.h>
+// ThreadSanitizer cannot see TBB's own synchronisation (libtbb is not instrumented), so
+// every parallel loop would be reported as a race: the TSan build runs TBB loops on the
+// calling thread and checks Lumar's own threads (capture, tracker, live pipelines).
+static const tbb::global_control tsan_serial_tbb(tbb::global_control::max_allowed_parallelism, 1);
+#endif
+
 int main(int argc, char** argv) {
   // FFmpeg's own log lines (e.g. "overread 8" on a damaged segment) would break the
   // promise of one clear error line; Lumar detects and reports those faults itself.

@@ -1,5 +1,11 @@
 #include "test_paths.h"
 
+#if defined(__SANITIZE_THREAD__)
+#include <tbb/global_control.h>
+// As in app/main.cpp: TSan cannot see TBB's synchronisation, so TBB loops run serially.
+static const tbb::global_control tsan_serial_tbb(tbb::global_control::max_allowed_parallelism, 1);
+#endif
+
 #include <unistd.h>
 
 #include <algorithm>
