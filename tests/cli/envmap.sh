@@ -318,15 +318,19 @@ case_live_stops_cleanly_on_sigint() {
   wait_for 5 eval '! kill -0 '"$pid"' 2>/dev/null' || fail "envmap did not stop within 5 s of SIGINT"
   wait "$pid" || { cat "$TMP/live.log"; fail "envmap exited with an error after SIGINT"; }
   cat "$TMP/live.log"
-  grep -q "^envmap: 200 frames" "$TMP/live.log" && fail "SIGINT did not stop the sweep early"
+  local frames
+  frames=$(sed -n 's/^envmap: \([0-9]*\) frames, .*/\1/p' "$TMP/live.log")
+  [ -n "$frames" ] || fail "no summary line"
+  [ "$frames" -lt 160 ] || fail "SIGINT did not stop the sweep early: all $frames frames were read"
   is_exr "$TMP/live.exr" || fail "no EXR after SIGINT"
   no_leftovers || fail "temporary files left behind"
 }
 
 case_live_tracker_vanishes() {
   # The tracker is unplugged mid-sweep: one line says so, the sweep goes on without
-  # stitching, and the map written before stays.
-  two_station_camera 20 1000
+  # stitching, and the map written before stays. The second station's frames come 3 s in,
+  # so the unplug (right after the first map) falls inside the sweep even on a loaded machine.
+  two_station_camera 20 3000
   "$LUMAR" "${LIVE_STILL[@]}" --update-every 0.3 >"$TMP/live.log" 2>&1 &
   local pid=$!
   PIDS+=("$pid")
