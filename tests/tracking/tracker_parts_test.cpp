@@ -126,8 +126,11 @@ TEST(SpscRing, KeepsOrderRefusesWhenFullAndCrossesThreads) {
       if (shared.push(i)) ++i;
   });
   std::int64_t expected = 0;
-  while (expected < kItems)
-    if (auto v = shared.pop()) ASSERT_EQ(*v, expected++);
+  while (expected < kItems) {
+    if (auto v = shared.pop()) {
+      ASSERT_EQ(*v, expected++);
+    }
+  }
   producer.join();
 }
 
