@@ -55,7 +55,7 @@ const Sweep& sweep() {
     for (int k = 0; k < 180; ++k) {
       const glm::dquat truth = calib::sweep_rotation((k / 3 + 0.5) / 60);
       s.truth.push_back(truth);
-      s.tracker.push_back(glm::normalize(calib::rotation_exp({normal(random), normal(random), normal(random)}) * truth));
+      s.tracker.push_back(glm::normalize(rotation_exp({normal(random), normal(random), normal(random)}) * truth));
       s.groups.push_back(k / 3);
       s.exposures.push_back(base * std::exp2(stops[k % 3]));
       s.frames.push_back(calib::expose_8bit(view.render(s.source, truth), s.camera, sensor, s.exposures.back(), rng));

@@ -10,23 +10,6 @@
 
 namespace lumar::calib {
 
-glm::dvec3 rotation_vector(const glm::dquat& q_in) {
-  glm::dquat q = glm::normalize(q_in);
-  if (q.w < 0) q = -q;
-  const glm::dvec3 v(q.x, q.y, q.z);
-  const double s = glm::length(v);
-  if (s < 1e-12) return 2.0 * v;
-  return v * (2.0 * std::atan2(s, q.w) / s);
-}
-
-glm::dquat quat_from_rotation_vector(const glm::dvec3& v) {
-  const double angle = glm::length(v);
-  if (angle < 1e-12) return glm::normalize(glm::dquat(1.0, 0.5 * v.x, 0.5 * v.y, 0.5 * v.z));
-  const glm::dvec3 axis = v / angle;
-  const double s = std::sin(0.5 * angle);
-  return {std::cos(0.5 * angle), axis.x * s, axis.y * s, axis.z * s};
-}
-
 std::vector<int> spread_rotations(const std::vector<glm::dquat>& rotations, int count) {
   const int n = int(rotations.size());
   std::vector<int> picked;

@@ -14,21 +14,6 @@
 
 namespace lumar::calib {
 
-glm::dquat rotation_exp(const glm::dvec3& v) {
-  const double angle = glm::length(v);
-  if (angle < 1e-12) return glm::normalize(glm::dquat(1.0, 0.5 * v.x, 0.5 * v.y, 0.5 * v.z));
-  return glm::angleAxis(angle, v / angle);
-}
-
-glm::dvec3 rotation_log(const glm::dquat& q_in) {
-  glm::dquat q = glm::normalize(q_in);
-  if (q.w < 0) q = -q;
-  const glm::dvec3 axis(q.x, q.y, q.z);
-  const double s = glm::length(axis);
-  if (s < 1e-12) return 2.0 * axis;
-  return axis * (2.0 * std::atan2(s, q.w) / s);
-}
-
 FrameFeatures extract_frame_features(const cv::Mat& image, const CameraIntrinsics& camera,
                                      const CameraResponse& response, const FeatureSettings& settings) {
   if (image.type() != CV_8UC3 || image.cols != camera.width || image.rows != camera.height)

@@ -30,7 +30,7 @@ std::string fmt(double v, int decimals = 1) {
 
 Pose perturbed(const Pose& p, const double* d) {
   Pose out;
-  out.rotation = glm::normalize(p.rotation * quat_from_rotation_vector({d[0], d[1], d[2]}));
+  out.rotation = glm::normalize(p.rotation * rotation_exp({d[0], d[1], d[2]}));
   out.translation = p.translation + glm::dvec3(d[3], d[4], d[5]);
   return out;
 }
@@ -72,7 +72,7 @@ struct RigModel {
       if (!camera) return false;
       const Pose predicted = Z * *camera * X_inv;
       const Pose& measured = sample.T_transmitter_sensor;
-      const glm::dvec3 rot = rotation_vector(glm::conjugate(measured.rotation) * predicted.rotation);
+      const glm::dvec3 rot = rotation_log(glm::conjugate(measured.rotation) * predicted.rotation);
       const glm::dvec3 pos = predicted.translation - measured.translation;
       for (int a = 0; a < 3; ++a) {
         r[6 * k + std::size_t(a)] = rot[a] / sigma_rotation_rad;

@@ -123,6 +123,18 @@ TEST(Pose, InterpolationFollowsConstantAngularVelocity) {
   EXPECT_NEAR(glm::length(m.translation - glm::dvec3(0.25, 0.5, 0.75)), 0, 1e-12);
 }
 
+TEST(Pose, RotationLogAndExpRoundTrip) {
+  for (const glm::dvec3 v : {glm::dvec3(0.3, -0.2, 0.5), glm::dvec3(0.1, -0.2, 0.3), glm::dvec3(3.0, 0, 0),
+                             glm::dvec3(1e-9, 0, 0)})
+    EXPECT_LT(glm::length(rotation_log(rotation_exp(v)) - v), 1e-12);
+  EXPECT_NEAR(rotation_angle_deg(rotation_exp(glm::dvec3(0, glm::radians(30.0), 0)), glm::dquat(1, 0, 0, 0)), 30.0,
+              1e-9);
+  EXPECT_NEAR(glm::length(rotation_log(glm::dquat(1, 0, 0, 0))), 0.0, 1e-15);
+  // The short way: q and -q are one rotation.
+  const glm::dquat q = rotation_exp({0, 0.4, 0});
+  EXPECT_LT(glm::length(rotation_log(-q) - glm::dvec3(0, 0.4, 0)), 1e-12);
+}
+
 TEST(Camera, DistortedProjectionMatchesOpenCV) {
   CameraIntrinsics c{640, 480, 536.1, 536.0, 342.4, 235.5, {-0.27, 0.09, 0.0012, -0.0004, 0.02}};
   std::vector<cv::Point3d> pts;

@@ -80,7 +80,7 @@ const Sweep& synthetic_sweep(const SweepSpec& spec) {
     const double exposure = base * std::exp2(spec.exposure_stops[k % spec.exposure_stops.size()]);
     const glm::dvec3 noise(normal(random), normal(random), normal(random));
     sweep.truth.push_back(truth);
-    sweep.tracker.push_back(glm::normalize(calib::rotation_exp(noise) * truth));
+    sweep.tracker.push_back(glm::normalize(rotation_exp(noise) * truth));
     sweep.exposures.push_back(exposure);
     sweep.frames.push_back(calib::expose_8bit(view.render(sweep.source, truth), sweep.camera, sweep.sensor, exposure, rng));
   }

@@ -15,16 +15,6 @@ double smoothing(double cutoff_hz, double dt) {
   return r / (1 + r);
 }
 
-// Rotation vector (axis * angle, radians) of the rotation taking a to b, the short way.
-glm::dvec3 rotation_vector(const glm::dquat& a, const glm::dquat& b) {
-  glm::dquat d = b * glm::inverse(a);
-  if (d.w < 0) d = -d;
-  const glm::dvec3 v(d.x, d.y, d.z);
-  const double s = glm::length(v);
-  if (s == 0) return glm::dvec3(0.0);
-  return v * (2 * std::atan2(s, d.w) / s);
-}
-
 }  // namespace
 
 void validate_one_euro(const OneEuroSettings& s, const char* what) {
@@ -57,7 +47,7 @@ Pose OneEuroPoseFilter::filter(const Pose& pose, Nanos time) {
 
   glm::dquat target = pose.rotation;
   if (glm::dot(target, s.out.rotation) < 0) target = -target;  // the short way
-  const glm::dvec3 w = rotation_vector(s.out.rotation, target) / dt;
+  const glm::dvec3 w = rotation_log(target * glm::inverse(s.out.rotation)) / dt;
   s.angular_velocity += smoothing(R.d_cutoff_hz, dt) * (w - s.angular_velocity);
   const double a = smoothing(R.min_cutoff_hz + R.beta * glm::length(s.angular_velocity), dt);
   s.out.rotation = glm::normalize(glm::slerp(s.out.rotation, target, a));

@@ -42,9 +42,5 @@ std::vector<int> spread_rotations(const std::vector<glm::dquat>& rotations, int 
 // is the maximum-likelihood mean for small isotropic noise) and mean of translations.
 Pose mean_pose(const std::vector<Pose>& poses);
 
-// Rotation vector (axis * angle, radians) of a unit quaternion, angle in [0, pi].
-glm::dvec3 rotation_vector(const glm::dquat& q);
-// Quaternion of a rotation vector (radians).
-glm::dquat quat_from_rotation_vector(const glm::dvec3& v);
 
 }  // namespace lumar::calib

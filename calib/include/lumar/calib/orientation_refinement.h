@@ -65,8 +65,5 @@ RefinementResult refine_orientations(const std::vector<FrameFeatures>& features,
                                      const RefinementSettings& settings = {},
                                      const std::vector<int>& groups = {});
 
-// Rotation helpers on SO(3) (rotation vectors in radians).
-glm::dquat rotation_exp(const glm::dvec3& v);
-glm::dvec3 rotation_log(const glm::dquat& q);
 
 }  // namespace lumar::calib

@@ -27,6 +27,11 @@ glm::dquat axis_angle_deg(const glm::dvec3& axis, double angle_deg);
 // Angle of the relative rotation between a and b, in degrees (0..180).
 double rotation_angle_deg(const glm::dquat& a, const glm::dquat& b);
 
+// SO(3)'s log and exp: the rotation vector (axis * angle, radians, angle in [0, pi], the
+// short way) of a quaternion, and back.
+glm::dvec3 rotation_log(const glm::dquat& q);
+glm::dquat rotation_exp(const glm::dvec3& v);
+
 // Shortest-path slerp of rotation and linear interpolation of translation, s in [0, 1].
 Pose interpolate(const Pose& a, const Pose& b, double s);
 
