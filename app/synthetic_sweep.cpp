@@ -12,7 +12,6 @@
 #include "lumar/capture/session.h"
 #include "lumar/core/envmap.h"
 #include "lumar/core/error.h"
-#include "lumar/core/latlong.h"
 #include "lumar/tracking/simulated_tracker.h"
 
 namespace lumar::app {
@@ -21,17 +20,9 @@ namespace {
 
 // Exposure that puts the map's mean luminance (solid-angle weighted) at 18 % grey.
 double automatic_exposure(const EnvironmentMap& map, const std::string& name) {
-  double sum = 0, wsum = 0;
-  for (int r = 0; r < map.height; ++r) {
-    const double w = latlong_pixel_solid_angle(r, map.width, map.height);
-    for (int c = 0; c < map.width; ++c) {
-      const glm::vec3 t = map.texel(c, r);
-      sum += w * (0.2126 * t.r + 0.7152 * t.g + 0.0722 * t.b);
-      wsum += w;
-    }
-  }
-  if (!(sum > 0) || !std::isfinite(sum)) throw InputError(name + ": the map is black or not finite; nothing to see");
-  return 0.18 / (sum / wsum);
+  const double mean = mean_luminance(map);
+  if (!(mean > 0) || !std::isfinite(mean)) throw InputError(name + ": the map is black or not finite; nothing to see");
+  return 0.18 / mean;
 }
 
 // When each frame is taken and where the camera points at any moment.

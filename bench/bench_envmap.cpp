@@ -18,7 +18,6 @@
 #include "lumar/calib/hole_filling.h"
 #include "lumar/calib/orientation_refinement.h"
 #include "lumar/calib/sweep_path.h"
-#include "lumar/core/latlong.h"
 
 using namespace lumar;
 
@@ -38,14 +37,7 @@ const Sweep& sweep() {
     Sweep s;
     s.source = load_environment_map(LUMAR_SOURCE_DIR "/../shared/data/envmaps/courtyard.exr");
     s.camera = calib::load_camera_file(LUMAR_SOURCE_DIR "/data/camera/webcam-640x480.yml").intrinsics;
-    double sum = 0, wsum = 0;
-    for (int r = 0; r < s.source.height; ++r)
-      for (int c = 0; c < s.source.width; ++c) {
-        const double w = latlong_pixel_solid_angle(r, s.source.width, s.source.height);
-        const glm::vec3 t = s.source.texel(c, r);
-        sum += w * (0.2126 * t.r + 0.7152 * t.g + 0.0722 * t.b), wsum += w;
-      }
-    const double base = 0.18 / (sum / wsum);
+    const double base = 0.18 / mean_luminance(s.source);
     const calib::EnvmapViewRenderer view(s.camera);
     const calib::SensorModel sensor;
     const double stops[3] = {4, -1, -6};

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "lumar/core/color.h"
 #include "lumar/core/error.h"
 #include "lumar/core/latlong.h"
 
@@ -43,6 +44,18 @@ glm::vec3 EnvironmentMap::radiance(const glm::dvec3& world) const {
   const glm::dvec3 top = glm::dvec3(texel(c0, r0)) * (1.0 - fx) + glm::dvec3(texel(c1, r0)) * fx;
   const glm::dvec3 bottom = glm::dvec3(texel(c0, r1)) * (1.0 - fx) + glm::dvec3(texel(c1, r1)) * fx;
   return glm::vec3(top * (1.0 - fy) + bottom * fy);
+}
+
+double mean_luminance(const EnvironmentMap& map) {
+  double sum = 0, wsum = 0;
+  for (int r = 0; r < map.height; ++r) {
+    const double w = latlong_pixel_solid_angle(r, map.width, map.height);
+    for (int c = 0; c < map.width; ++c) {
+      sum += w * luminance(map.texel(c, r));
+      wsum += w;
+    }
+  }
+  return wsum > 0 ? sum / wsum : 0.0;
 }
 
 EnvironmentMap load_environment_map(const std::filesystem::path& path) {

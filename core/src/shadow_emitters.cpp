@@ -1,3 +1,4 @@
+#include "lumar/core/color.h"
 #include "lumar/core/shadow_emitters.h"
 
 #include <algorithm>
@@ -11,8 +12,6 @@
 namespace lumar {
 
 namespace {
-
-double luminance(const glm::vec3& c) { return 0.2126 * c.r + 0.7152 * c.g + 0.0722 * c.b; }
 
 // The map box-filtered to width x width/2 (radiance averaged with solid-angle weights).
 std::vector<glm::vec3> downsample(const EnvironmentMap& map, int width) {

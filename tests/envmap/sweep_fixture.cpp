@@ -8,7 +8,6 @@
 #include "lumar/calib/camera_file.h"
 #include "lumar/calib/orientation_refinement.h"
 #include "lumar/calib/sweep_path.h"
-#include "lumar/core/latlong.h"
 #include "test_paths.h"
 
 namespace lumar::test {
@@ -17,18 +16,7 @@ CameraIntrinsics webcam() {
   return calib::load_camera_file(source_dir() / "data/camera/webcam-640x480.yml").intrinsics;
 }
 
-double auto_exposure(const EnvironmentMap& map) {
-  double sum = 0, wsum = 0;
-  for (int r = 0; r < map.height; ++r) {
-    const double w = latlong_pixel_solid_angle(r, map.width, map.height);
-    for (int c = 0; c < map.width; ++c) {
-      const glm::vec3 t = map.texel(c, r);
-      sum += w * (0.2126 * t.r + 0.7152 * t.g + 0.0722 * t.b);
-      wsum += w;
-    }
-  }
-  return 0.18 / (sum / wsum);
-}
+double auto_exposure(const EnvironmentMap& map) { return 0.18 / mean_luminance(map); }
 
 double rms_angle_deg(const std::vector<glm::dquat>& a, const std::vector<glm::dquat>& b) {
   double sum = 0;

@@ -24,6 +24,9 @@ struct EnvironmentMap {
   glm::vec3 radiance(const glm::dvec3& world_direction) const;
 };
 
+// Mean luminance over the sphere, each texel weighted by its solid angle.
+double mean_luminance(const EnvironmentMap& map);
+
 // Reads an OpenEXR or Radiance HDR file through OpenImageIO (first three channels).
 // Throws InputError naming the file when it is missing, unreadable or not 2:1.
 EnvironmentMap load_environment_map(const std::filesystem::path& path);

@@ -18,6 +18,7 @@
 #include <memory>
 #include <vector>
 
+#include "lumar/core/color.h"
 #include "lumar/core/envmap.h"
 #include "lumar/core/mesh.h"
 #include "lumar/core/ray_scene.h"
@@ -121,9 +122,6 @@ class RoomRadiance {
   glm::dvec3 fallback_{0.0};
   mutable std::atomic<std::uint64_t> fallback_rays_{0}, traced_rays_{0};
 };
-
-// Luminance of linear RGB (Rec. 709).
-inline double luminance(const glm::dvec3& c) { return 0.2126 * c.r + 0.7152 * c.g + 0.0722 * c.b; }
 
 // The map box-filtered by solid angle to `height` rows (a divisor of its height; otherwise
 // the map unchanged). Power (Σ L Ω) is preserved.
