@@ -3,13 +3,14 @@
 #include <algorithm>
 #include <cmath>
 
+#include "lumar/core/color.h"
 #include "lumar/core/error.h"
 #include "lumar/core/latlong.h"
 
 namespace lumar::calib {
 
 namespace {
-double luminance(const float* p) { return 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2]; }
+double luminance(const float* p) { return lumar::luminance({p[0], p[1], p[2]}); }
 }  // namespace
 
 EnvironmentMap downsample_map(const EnvironmentMap& map, int width) {

@@ -11,6 +11,7 @@
 #include <numbers>
 #include <random>
 
+#include "lumar/core/color.h"
 #include "lumar/core/latlong.h"
 #include "test_geometry.h"
 #include "test_paths.h"
@@ -190,7 +191,6 @@ TEST(SphericalHarmonics, ErrorOnRealMaps) {
     const double phi = i * kPi * (3.0 - std::sqrt(5.0));
     normals.emplace_back(r * std::cos(phi), y, r * std::sin(phi));
   }
-  const auto luminance = [](const glm::dvec3& c) { return 0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z; };
   for (const char* name : {"city", "courtyard", "interior", "studio"}) {
     const EnvironmentMap map = load_environment_map(test::shared_dir() / "data/envmaps" / (std::string(name) + ".exr"));
     const SH9 sh = project_radiance_sh9(map);

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "lumar/core/color.h"
 #include "lumar/core/error.h"
 
 #include "lumar/calib/envmap_quality.h"
@@ -146,12 +147,11 @@ Quality reconstruct(const test::Sweep& sweep, const std::vector<glm::dquat>& rot
   q.coverage = double(cv::countNonZero(coverage)) / coverage.total();
   const SH9 sh_result = project_radiance_sh9(result), sh_reference = project_radiance_sh9(reference);
   for (const glm::dvec3& n : calib::fibonacci_directions(48)) {
-    const auto lum = [](const glm::dvec3& e) { return 0.2126 * e.x + 0.7152 * e.y + 0.0722 * e.z; };
-    const double want = lum(calib::irradiance_direct(reference, n));
+    const double want = luminance(calib::irradiance_direct(reference, n));
     q.worst_irradiance_direct =
-        std::max(q.worst_irradiance_direct, std::abs(lum(calib::irradiance_direct(result, n)) - want) / want);
-    const double want_sh = lum(sh9_irradiance(sh_reference, n));
-    q.worst_irradiance_sh = std::max(q.worst_irradiance_sh, std::abs(lum(sh9_irradiance(sh_result, n)) - want_sh) / want_sh);
+        std::max(q.worst_irradiance_direct, std::abs(luminance(calib::irradiance_direct(result, n)) - want) / want);
+    const double want_sh = luminance(sh9_irradiance(sh_reference, n));
+    q.worst_irradiance_sh = std::max(q.worst_irradiance_sh, std::abs(luminance(sh9_irradiance(sh_result, n)) - want_sh) / want_sh);
   }
   return q;
 }
