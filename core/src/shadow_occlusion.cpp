@@ -161,11 +161,17 @@ LineShadows::LineShadows(ShadowLines lines) : lines_(std::move(lines)) {
   attenuation_.assign(lines_.receiver_count(), glm::vec3(1.0f));
   const ReceiverGrids& grids = lines_.grids;
   // Structure of arrays, padded: four receivers are tested against a cone at once.
-  for (auto* v : {&ordered_x_, &ordered_y_, &ordered_z_}) v->assign(grids.order.size() + 4, 0.0f);
+  for (auto* v : {&ordered_u_, &ordered_v_}) v->assign(grids.order.size() + 4, 0.0f);
+  for (const ReceiverGrid& g : grids.grids) {
+    const std::uint32_t from = grids.bucket_first[g.first_bucket];
+    const std::uint32_t to = grids.bucket_first[g.first_bucket + std::uint32_t(g.nu * g.nv)];
+    for (std::uint32_t k = from; k < to; ++k) {
+      const glm::vec3 d = lines_.origins[grids.order[k]] - g.origin;
+      ordered_u_[k] = glm::dot(d, g.u_axis), ordered_v_[k] = glm::dot(d, g.v_axis);
+    }
+  }
   std::vector<std::uint32_t> position(lines_.receiver_count(), 0);  // a receiver's place in grid order
   for (std::size_t k = 0; k < grids.order.size(); ++k) {
-    const glm::vec3& x = lines_.origins[grids.order[k]];
-    ordered_x_[k] = x.x, ordered_y_[k] = x.y, ordered_z_[k] = x.z;
     position[grids.order[k]] = std::uint32_t(k);
   }
   chunks_ = (grids.order.size() + 63) / 64;
@@ -191,7 +197,6 @@ void LineShadows::place(Object& o, const glm::dmat4& T) {
   o.T_world_model = T;
   o.T_model_world = glm::mat4(glm::inverse(T));
   const auto to_world = [&](const glm::vec3& p) { return glm::vec3(T * glm::dvec4(glm::dvec3(p), 1.0)); };
-  for (int k = 0; k < 8; ++k) o.box[std::size_t(k)] = to_world(o.model_box[std::size_t(k)]);
   o.parts.resize(o.model_parts.size());
   for (std::size_t p = 0; p < o.model_parts.size(); ++p)
     for (int k = 0; k < 8; ++k) o.parts[p][std::size_t(k)] = to_world(o.model_parts[p][std::size_t(k)]);
@@ -200,7 +205,6 @@ void LineShadows::place(Object& o, const glm::dmat4& T) {
 int LineShadows::add_object(const Mesh& model, const glm::dmat4& T_world_model) {
   Object o;
   if (model.triangle_count() > 0) {
-    o.model_box = bounding_box(model.positions);
     std::vector<std::uint32_t> tris(model.triangle_count());
     for (std::uint32_t t = 0; t < tris.size(); ++t) tris[t] = t;
     split_parts(model, tris, 0, tris.size(), kPartDepth, o.model_parts);
@@ -228,49 +232,63 @@ void LineShadows::set_culling(bool on) {
 
 namespace {
 
-// A cone's footprint on a receiver grid, conservatively: per cone plane, the half-plane
-// a u + b v + c <= 0 of grid points (u, v) above or below which, at some height of the
-// grid's slab, a point passes that plane. `f(j, i0, i1)`: buckets i0..i1 of row j.
-template <class F>
-std::size_t scan_footprint(const ShadowCone& cone, const ReceiverGrid& g, F&& f) {
-  constexpr float kSlack = 1e-4f;  // metres: float error of the grid coordinates
-  const int n = cone.plane_count();
-  // a u + b v + c <= 0, kept as u <= or >= (-c - b v) / a: reciprocals, not divisions, per row.
-  float A[ShadowCone::kMaxPlanes], B[ShadowCone::kMaxPlanes], C[ShadowCone::kMaxPlanes], invA[ShadowCone::kMaxPlanes];
-  for (int k = 0; k < n; ++k) {
-    const glm::vec4& p = cone.plane(k);
-    const glm::vec3 nrm(p);
-    const float hn = glm::dot(nrm, g.normal);
-    A[k] = glm::dot(nrm, g.u_axis), B[k] = glm::dot(nrm, g.v_axis);
-    C[k] = glm::dot(nrm, g.origin) + p.w + std::min(hn * (g.h_min - kSlack), hn * (g.h_max + kSlack)) -
-           ShadowCone::kMargin - kSlack * (std::abs(A[k]) + std::abs(B[k]));
-    invA[k] = A[k] != 0.0f ? 1.0f / A[k] : 0.0f;
+// A cone's footprint on a receiver grid: per cone plane, the half-plane a u + b v + c <= 0
+// of grid points (u, v) that lie inside that plane at some height of the grid's slab
+// (with room for float error), so it holds every receiver inside the cone.
+struct Footprint {
+  int n = 0;
+  float a[ShadowCone::kMaxPlanes], b[ShadowCone::kMaxPlanes], c[ShadowCone::kMaxPlanes];
+  Footprint(const ShadowCone& cone, const ReceiverGrid& g) : n(cone.plane_count()) {
+    constexpr float kSlack = 1e-4f;  // metres: float error of the grid coordinates
+    for (int k = 0; k < n; ++k) {
+      const glm::vec4& p = cone.plane(k);
+      const glm::vec3 nrm(p);
+      const float hn = glm::dot(nrm, g.normal);
+      a[k] = glm::dot(nrm, g.u_axis), b[k] = glm::dot(nrm, g.v_axis);
+      c[k] = glm::dot(nrm, g.origin) + p.w + std::min(hn * g.h_min, hn * g.h_max) - ShadowCone::kMargin -
+             kSlack * (std::abs(a[k]) + std::abs(b[k]) + std::abs(hn));
+    }
   }
+};
+
+// The buckets of a footprint, row by row: f(j, i0, i1) for the buckets i0..i1 of row j
+// that it may touch. Returns the number of rows scanned.
+template <class F>
+std::size_t scan_footprint(const Footprint& fp, const ReceiverGrid& g, F&& f) {
+  // Over a row's band of v, a half-plane bounds u on one side by a linear function of
+  // the row index j: u <= or >= alpha + beta j. Precomputed, a row costs two operations
+  // per plane.
+  float up_alpha[ShadowCone::kMaxPlanes], up_beta[ShadowCone::kMaxPlanes];
+  float down_alpha[ShadowCone::kMaxPlanes], down_beta[ShadowCone::kMaxPlanes];
+  int ups = 0, downs = 0;
   const float u_lo = g.u0, u_hi = g.u0 + float(g.nu) * g.cell;
-  // Rows: each half-plane over the grid's u range bounds v.
   float v_lo = g.v0, v_hi = g.v0 + float(g.nv) * g.cell;
-  for (int k = 0; k < n; ++k) {
-    const float amin = std::min(A[k] * u_lo, A[k] * u_hi);
-    if (B[k] > 0.0f) v_hi = std::min(v_hi, (-C[k] - amin) / B[k]);
-    else if (B[k] < 0.0f) v_lo = std::max(v_lo, (-C[k] - amin) / B[k]);
-    else if (amin + C[k] > 0.0f) return 0;
+  for (int k = 0; k < fp.n; ++k) {
+    const float a = fp.a[k], b = fp.b[k], c = fp.c[k];
+    // The rows: the half-plane over the grid's whole u range bounds v.
+    const float amin = std::min(a * u_lo, a * u_hi);
+    if (b > 0.0f) v_hi = std::min(v_hi, (-c - amin) / b);
+    else if (b < 0.0f) v_lo = std::max(v_lo, (-c - amin) / b);
+    else if (amin + c > 0.0f) return 0;
+    if (a == 0.0f) continue;  // bounds v only: done above
+    // Row j spans v0 + [j, j + 1] cell; the smallest b v over it is at its low end for b > 0.
+    const float v_at = g.v0 + (b < 0.0f ? g.cell : 0.0f);
+    const float alpha = (-c - b * v_at) / a, beta = -b * g.cell / a;
+    if (a > 0.0f) up_alpha[ups] = alpha, up_beta[ups++] = beta;
+    else down_alpha[downs] = alpha, down_beta[downs++] = beta;
   }
   if (!(v_lo <= v_hi)) return 0;
   const int j0 = std::clamp(int(std::floor((v_lo - g.v0) / g.cell)), 0, g.nv - 1);
   const int j1 = std::clamp(int(std::floor((v_hi - g.v0) / g.cell)), 0, g.nv - 1);
+  const float inv_cell = 1.0f / g.cell;
   for (int j = j0; j <= j1; ++j) {
-    const float va = g.v0 + float(j) * g.cell, vb = va + g.cell;
+    const float fj = float(j);
     float lo = u_lo, hi = u_hi;
-    bool empty = false;
-    for (int k = 0; k < n && !empty; ++k) {
-      const float bmin = std::min(B[k] * va, B[k] * vb);
-      if (A[k] > 0.0f) hi = std::min(hi, (-C[k] - bmin) * invA[k]);
-      else if (A[k] < 0.0f) lo = std::max(lo, (-C[k] - bmin) * invA[k]);
-      else empty = bmin + C[k] > 0.0f;
-    }
-    if (empty || !(lo <= hi)) continue;
-    const int i0 = std::clamp(int(std::floor((lo - g.u0) / g.cell)), 0, g.nu - 1);
-    const int i1 = std::clamp(int(std::floor((hi - g.u0) / g.cell)), 0, g.nu - 1);
+    for (int k = 0; k < ups; ++k) hi = std::min(hi, up_alpha[k] + up_beta[k] * fj);
+    for (int k = 0; k < downs; ++k) lo = std::max(lo, down_alpha[k] + down_beta[k] * fj);
+    if (!(lo <= hi)) continue;
+    const int i0 = std::clamp(int(std::floor((lo - g.u0) * inv_cell)), 0, g.nu - 1);
+    const int i1 = std::clamp(int(std::floor((hi - g.u0) * inv_cell)), 0, g.nu - 1);
     f(j, i0, i1);
   }
   return std::size_t(j1 - j0 + 1);
@@ -284,17 +302,15 @@ std::uint32_t ones(std::uint64_t x) {
   return std::uint32_t((x * 0x0101010101010101ull) >> 56);
 }
 
-// Which of four receivers (bits 0-3) lie inside the cone: the planes once, four lanes at a time.
+// Which of four receivers (bits 0-3) lie inside the outer footprint: the half-planes
+// once, four lanes at a time.
 using Float4 = float __attribute__((vector_size(16)));
 using Int4 = std::int32_t __attribute__((vector_size(16)));
-unsigned inside4(const ShadowCone& cone, const float* xs, const float* ys, const float* zs) {
-  Float4 x, y, z;
-  std::memcpy(&x, xs, sizeof x), std::memcpy(&y, ys, sizeof y), std::memcpy(&z, zs, sizeof z);
+unsigned inside4(const Footprint& fp, const float* us, const float* vs) {
+  Float4 u, v;
+  std::memcpy(&u, us, sizeof u), std::memcpy(&v, vs, sizeof v);
   Int4 in = {-1, -1, -1, -1};
-  for (int i = 0; i < cone.plane_count(); ++i) {
-    const glm::vec4& p = cone.plane(i);
-    in &= x * p.x + y * p.y + z * p.z + p.w <= ShadowCone::kMargin;
-  }
+  for (int k = 0; k < fp.n; ++k) in &= u * fp.a[k] + v * fp.b[k] + fp.c[k] <= 0.0f;
   return unsigned(in[0] & 1) | unsigned(in[1] & 2) | unsigned(in[2] & 4) | unsigned(in[3] & 8);
 }
 
@@ -305,29 +321,19 @@ unsigned inside4(const ShadowCone& cone, const float* xs, const float* ys, const
 void LineShadows::cull(const Object& o, std::uint32_t sample) {
   const glm::vec3& e = lines_.samples[sample].position;
   const ReceiverGrids& grids = lines_.grids;
-  // Most samples' shadows miss the receivers: one cone around the whole mesh first.
-  {
-    const ShadowCone whole(o.box, e, lines_.distant);
-    bool any = false;
-    for (const ReceiverGrid& g : grids.grids) {
-      any = scan_footprint(whole, g, [](int, int, int) {}) > 0;
-      if (any) break;
-    }
-    if (!any) return;
-  }
   std::size_t rows = 0, tested = 0;  // locals: the loop below stays in registers
   for (std::size_t p = 0; p < o.model_parts.size(); ++p) {
     const ShadowCone cone(o.parts[p], e, lines_.distant);
-
-    for (const ReceiverGrid& g : grids.grids)
-      rows += scan_footprint(cone, g, [&](int j, int i0, int i1) {
+    for (const ReceiverGrid& g : grids.grids) {
+      const Footprint fp(cone, g);
+      rows += scan_footprint(fp, g, [&](int j, int i0, int i1) {
         const std::uint32_t b = g.first_bucket + std::uint32_t(j * g.nu);
         const std::uint32_t k1 = grids.bucket_first[b + std::uint32_t(i1) + 1];
         const std::uint32_t k0 = grids.bucket_first[b + std::uint32_t(i0)];
         tested += k1 - k0;
         for (std::uint32_t k = k0; k < k1; k += 4) {
-          const std::uint64_t in = inside4(cone, &ordered_x_[k], &ordered_y_[k], &ordered_z_[k]) &
-                                   (k1 - k >= 4 ? 15u : (1u << (k1 - k)) - 1u);
+          const std::uint64_t in =
+              inside4(fp, &ordered_u_[k], &ordered_v_[k]) & (k1 - k >= 4 ? 15u : (1u << (k1 - k)) - 1u);
           if (in == 0) continue;
           // Four bits into the sample's receiver bitset (they may straddle two words).
           const std::uint32_t w = k >> 6, shift = k & 63;
@@ -339,6 +345,7 @@ void LineShadows::cull(const Object& o, std::uint32_t sample) {
           }
         }
       });
+    }
   }
   stats_.rows_scanned += rows, stats_.receivers_tested += tested;
   // Receivers -> this sample's lines: the k-th present receiver of a chunk is line first + k.

@@ -62,10 +62,8 @@ class LineShadows {
   struct Object {
     glm::dmat4 T_world_model{1.0};
     glm::mat4 T_model_world{1.0f};
-    std::array<glm::vec3, 8> model_box{};            // box around the whole mesh, model space
     std::vector<std::array<glm::vec3, 8>> model_parts;  // boxes around pieces of it
-    std::array<glm::vec3, 8> box{};                  // their corners in world space, this pose
-    std::vector<std::array<glm::vec3, 8>> parts;
+    std::vector<std::array<glm::vec3, 8>> parts;     // their corners in world space, this pose
     std::shared_ptr<MeshBvh> bvh;
     // This frame, model space: every receiver's ray origin, every sample's line end
     // (distant: the line's direction and length).
@@ -87,7 +85,7 @@ class LineShadows {
     std::uint32_t line, receiver, sample;
   };
   std::vector<Candidate> candidates_;  // this object's, by sample then grid order
-  std::vector<float> ordered_x_, ordered_y_, ordered_z_;  // receiver origins in grid order (ShadowLines::grids.order)
+  std::vector<float> ordered_u_, ordered_v_;  // receiver origins in grid order (ShadowLines::grids.order), in their grid's (u, v)
   // Per (sample, chunk of 64 receivers in grid order): which have a line, and the first line.
   std::size_t chunks_ = 0;
   std::vector<std::uint64_t> chunk_mask_;
