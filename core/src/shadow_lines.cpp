@@ -5,15 +5,10 @@
 #include <algorithm>
 #include <numeric>
 
+#include "lumar/core/color.h"
 #include "lumar/core/error.h"
 
 namespace lumar {
-
-namespace {
-
-float max_channel(const glm::vec3& v) { return std::max(v.r, std::max(v.g, v.b)); }
-
-}  // namespace
 
 ShadowLines build_shadow_lines(const std::vector<glm::vec3>& positions, const std::vector<glm::vec3>& normals,
                                const Emitters& emitters, const RayScene& proxy, const ShadowLineOptions& options) {

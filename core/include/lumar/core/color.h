@@ -18,4 +18,7 @@ inline float linear_to_srgb(float v) {
 // Luminance of linear RGB (Rec. 709 primaries).
 inline double luminance(const glm::dvec3& c) { return 0.2126 * c.r + 0.7152 * c.g + 0.0722 * c.b; }
 
+// The largest of the three channels.
+inline float max_channel(const glm::vec3& c) { return c.r > c.g ? (c.r > c.b ? c.r : c.b) : (c.g > c.b ? c.g : c.b); }
+
 }  // namespace lumar

@@ -21,6 +21,8 @@
 
 namespace lumar {
 
+class OccluderMesh;
+
 struct ShadowFrameStats {
   bool recomputed = false;
   std::size_t rows_scanned = 0;       // grid rows a cone's footprint was scanned along
@@ -58,13 +60,11 @@ class LineShadows {
   const std::vector<std::uint32_t>& traced_lines() const { return traced_lines_; }
 
  private:
-  struct MeshBvh;  // Embree scene of one model-space mesh
   struct Object {
     glm::dmat4 T_world_model{1.0};
     glm::mat4 T_model_world{1.0f};
-    std::vector<std::array<glm::vec3, 8>> model_parts;  // boxes around pieces of it
-    std::vector<std::array<glm::vec3, 8>> parts;     // their corners in world space, this pose
-    std::shared_ptr<MeshBvh> bvh;
+    std::shared_ptr<const OccluderMesh> mesh;        // null: no triangles, casts no shadow
+    std::vector<std::array<glm::vec3, 8>> parts;     // its pieces' boxes in world space, this pose
     // This frame, model space: every receiver's ray origin, every sample's line end
     // (distant: the line's direction and length).
     std::vector<glm::vec3> origin_model, sample_model;
