@@ -6,6 +6,7 @@
 #include "lumar/core/irradiance_scene.h"
 #include "lumar/core/irradiance_volume.h"
 #include "lumar/core/mesh.h"
+#include "lumar/core/object_shadows.h"
 #include "lumar/core/shadow_methods.h"
 #include "lumar/core/shadow_occlusion.h"
 
@@ -56,34 +57,58 @@ Compositor::Compositor(const Scene& scene, const CameraIntrinsics& output_camera
   build_shadows(scene);
 }
 
-// Precomputes the shadow lines from the scene's receivers to its emitters; the objects
-// are the occluders.
+// Precomputes the shadow lines from the scene's receivers to its emitters (the objects
+// are the occluders), and with two objects or more their shadows on each other.
 void Compositor::build_shadows(const Scene& scene) {
   const ShadowScene shadow_scene(scene);
+  const auto& objects = shadow_scene.objects();
   const Mesh receivers = shadow_scene.receivers();
-  if (receivers.triangle_count() == 0 || shadow_scene.objects().empty()) return;
-  const Emitters emitters = shadow_scene.emitters(receivers.positions, receivers.normals);
-  shadows_ = std::make_shared<LineShadows>(
-      build_shadow_lines(receivers.positions, receivers.normals, emitters, shadow_scene.proxy()));
-  for (const auto& o : shadow_scene.objects()) shadows_->add_object(o.model, o.T_world_model);
-  renderer_->set_receivers(receivers);
-  spdlog::debug("shadows: {} receivers, {} emitter patches, {} lines", receivers.positions.size(),
-                emitters.patches.size(), shadows_->lines().lines.size());
+  const bool on_receivers = receivers.triangle_count() > 0 && !objects.empty();
+  if (!on_receivers && objects.size() < 2) return;
+  // Emitters ranked for the receivers or, without any, for the objects' own surfaces.
+  Mesh around = receivers;
+  if (!on_receivers)
+    for (const auto& o : objects) {
+      const Mesh posed = transformed(o.model, o.T_world_model);
+      around.positions.insert(around.positions.end(), posed.positions.begin(), posed.positions.end());
+      around.normals.insert(around.normals.end(), posed.normals.begin(), posed.normals.end());
+    }
+  const Emitters emitters = shadow_scene.emitters(around.positions, around.normals);
+  if (on_receivers) {
+    shadows_ = std::make_shared<LineShadows>(
+        build_shadow_lines(receivers.positions, receivers.normals, emitters, shadow_scene.proxy()));
+    for (const auto& o : objects) shadows_->add_object(o.model, o.T_world_model);
+    renderer_->set_receivers(receivers);
+    spdlog::debug("shadows: {} receivers, {} emitter patches, {} lines", receivers.positions.size(),
+                  emitters.patches.size(), shadows_->lines().lines.size());
+  }
+  if (objects.size() >= 2) {
+    object_shadows_ = std::make_shared<ObjectShadows>(emitters);
+    for (const auto& o : objects) object_shadows_->add_object(o.model, o.T_world_model);
+    spdlog::debug("objects shadow each other: {} objects, {} emitter samples", objects.size(),
+                  emitters.samples.size());
+  }
 }
 
 void Compositor::set_object_pose(std::size_t index, const glm::dmat4& T_world_model) {
   renderer_->set_object_pose(int(index), T_world_model);
   if (shadows_) shadows_->set_object_pose(int(index), T_world_model);
+  if (object_shadows_) object_shadows_->set_object_pose(int(index), T_world_model);
 }
 
 void Compositor::set_shadows_enabled(bool on) {
   if (on == shadows_enabled_) return;
   shadows_enabled_ = on;
-  shadows_uploaded_ = false;
+  shadows_uploaded_ = object_shadows_uploaded_ = false;
   if (shadows_ && !on) {
     const std::vector<glm::vec3> ones(shadows_->attenuation().size(), glm::vec3(1.0f));
     renderer_->set_receiver_attenuation(ones);
   }
+  if (object_shadows_ && !on)
+    for (std::size_t i = 0; i < object_shadows_->object_count(); ++i) {
+      const std::vector<glm::vec3> ones(object_shadows_->vertex_attenuation(int(i)).size(), glm::vec3(1.0f));
+      renderer_->set_object_light_attenuation(int(i), ones);
+    }
 }
 
 cv::Mat Compositor::composite(const cv::Mat& video_bgr8, const std::optional<Pose>& T_world_camera, double exposure,
@@ -91,6 +116,11 @@ cv::Mat Compositor::composite(const cv::Mat& video_bgr8, const std::optional<Pos
   if (shadows_ && shadows_enabled_ && (shadows_->update() || !shadows_uploaded_)) {
     renderer_->set_receiver_attenuation(shadows_->attenuation());
     shadows_uploaded_ = true;
+  }
+  if (object_shadows_ && shadows_enabled_ && (object_shadows_->update() || !object_shadows_uploaded_)) {
+    for (std::size_t i = 0; i < object_shadows_->object_count(); ++i)
+      renderer_->set_object_light_attenuation(int(i), object_shadows_->vertex_attenuation(int(i)));
+    object_shadows_uploaded_ = true;
   }
   return renderer_->render_overlay(video_bgr8, T_world_camera, exposure, timings);
 }

@@ -71,11 +71,11 @@ GlName create_texture_2d(GLenum internal_format, int width, int height, GLenum f
   return texture;
 }
 
-GlName create_buffer(const void* data, std::size_t bytes) {
+GlName create_buffer(const void* data, std::size_t bytes, GLbitfield flags) {
   GLuint id = 0;
   glCreateBuffers(1, &id);
   GlName buffer(id, delete_buffer);
-  glNamedBufferStorage(id, GLsizeiptr(bytes), data, 0);
+  glNamedBufferStorage(id, GLsizeiptr(bytes), data, flags);
   return buffer;
 }
 

@@ -42,7 +42,8 @@ class GlName {
 
 GlName create_texture_2d(GLenum internal_format, int width, int height, GLenum filter,
                          GLenum wrap_s, GLenum wrap_t);
-GlName create_buffer(const void* data, std::size_t bytes);
+// `flags`: glNamedBufferStorage's (GL_DYNAMIC_STORAGE_BIT: updatable with glNamedBufferSubData).
+GlName create_buffer(const void* data, std::size_t bytes, GLbitfield flags = 0);
 GlName create_framebuffer();
 GlName create_vertex_array();
 // Feeds vertex attribute `attribute` of `vertex_array` from a tightly packed vec3 buffer

@@ -29,6 +29,20 @@ GpuMesh::GpuMesh(const Mesh& mesh, const char* what) {
   indices_ = create_buffer(mesh.indices.data(), mesh.indices.size() * sizeof(std::uint32_t));
   glVertexArrayElementBuffer(vao, indices_.get());
   index_count_ = GLsizei(mesh.indices.size());
+  vertex_count_ = mesh.positions.size();
+}
+
+void GpuMesh::set_light_attenuation(std::span<const glm::vec3> attenuation) {
+  if (attenuation.size() != vertex_count_)
+    throw InputError(std::to_string(attenuation.size()) + " light attenuation values for a mesh of " +
+                     std::to_string(vertex_count_) + " vertices; pass one per vertex");
+  if (empty()) return;
+  if (!attenuation_) {
+    attenuation_ = create_buffer(attenuation.data(), attenuation.size_bytes(), GL_DYNAMIC_STORAGE_BIT);
+    attach_vec3_attribute(vertex_array_.get(), 2, attenuation_.get());
+  } else {
+    glNamedBufferSubData(attenuation_.get(), 0, GLsizeiptr(attenuation.size_bytes()), attenuation.data());
+  }
 }
 
 void GpuMesh::draw() const {

@@ -266,6 +266,7 @@ int Renderer::add_object(const Mesh& mesh_model) {
   o.mesh = GpuMesh(mesh_model, "virtual object mesh");
   if (mesh_model.normals.empty() && !mesh_model.indices.empty())
     throw InputError("Renderer::add_object: the virtual object mesh has no normals; load it with load_mesh");
+  o.mesh.set_light_attenuation(std::vector<glm::vec3>(mesh_model.positions.size(), glm::vec3(1.0f)));
   impl_->objects.push_back(std::move(o));
   check_gl_errors("Renderer::add_object");
   return int(impl_->objects.size()) - 1;
@@ -275,6 +276,11 @@ void Renderer::set_object_pose(int id, const glm::dmat4& T_world_model) {
   Impl::Object& o = impl_->object(id, "set_object_pose");
   o.model = glm::mat4(T_world_model);
   o.normal_matrix = glm::mat3(glm::transpose(glm::inverse(glm::dmat3(T_world_model))));
+}
+
+void Renderer::set_object_light_attenuation(int id, std::span<const glm::vec3> attenuation) {
+  impl_->object(id, "set_object_light_attenuation").mesh.set_light_attenuation(attenuation);
+  check_gl_errors("Renderer::set_object_light_attenuation");
 }
 
 void Renderer::set_object_material(int id, const glm::vec3& albedo, const SH9& irradiance_sh) {

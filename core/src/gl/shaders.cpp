@@ -15,17 +15,20 @@ const char* const kMeshVertex = R"glsl(
 #version 450 core
 layout(location = 0) in vec3 position;
 layout(location = 1) in vec3 normal;
+layout(location = 2) in vec3 light_attenuation;  // objects: what other objects take of the light
 uniform mat4 model;
 uniform mat3 normal_matrix;
 uniform mat4 view_projection;
 out vec3 world_position;
 out vec3 world_normal;
+out vec3 attenuation;
 // The objects' depth pre-pass and their shaded pass must agree to the bit (GL_LEQUAL).
 invariant gl_Position;
 void main() {
   vec4 w = model * vec4(position, 1.0);
   world_position = w.xyz;
   world_normal = normal_matrix * normal;
+  attenuation = light_attenuation;
   gl_Position = view_projection * w;
 }
 )glsl";
@@ -77,6 +80,7 @@ const char* const kShadedObjectFragment = R"glsl(
 #version 450 core
 in vec3 world_position;
 in vec3 world_normal;
+in vec3 attenuation;
 uniform vec3 albedo;
 uniform float exposure;
 uniform vec3 sh[9];  // L00, L1-1, L10, L11, L2-2, L2-1, L20, L21, L22 (world frame)
@@ -97,6 +101,7 @@ void main() {
   vec3 n = normalize(world_normal);
   // Nine coefficients can ring below zero opposite a bright source; light is never negative.
   vec3 irradiance = use_volume ? volume_irradiance(world_position, n) : max(sh_irradiance(n), vec3(0.0));
+  irradiance *= clamp(attenuation, 0.0, 1.0);
   color = vec4(albedo * irradiance * (exposure / 3.14159265358979), 1.0);
 }
 )glsl";

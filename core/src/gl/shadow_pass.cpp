@@ -30,16 +30,6 @@ out vec4 color;
 void main() { color = vec4(clamp(vertex_attenuation, 0.0, 1.0), 1.0); }
 )glsl";
 
-void delete_buffer(GLuint id) { glDeleteBuffers(1, &id); }
-
-GlName dynamic_buffer(const void* data, std::size_t bytes) {
-  GLuint id = 0;
-  glCreateBuffers(1, &id);
-  GlName buffer(id, delete_buffer);
-  glNamedBufferStorage(id, GLsizeiptr(bytes), data, GL_DYNAMIC_STORAGE_BIT);
-  return buffer;
-}
-
 }  // namespace
 
 ShadowPass::ShadowPass() { program_ = create_program("shadow receivers", kReceiverVertex, kReceiverFragment); }
@@ -56,7 +46,7 @@ void ShadowPass::set_receivers(const Mesh& mesh) {
   positions_ = create_buffer(mesh.positions.data(), mesh.positions.size() * sizeof(glm::vec3));
   attach_vec3_attribute(vao, 0, positions_.get());
   const std::vector<glm::vec3> ones(mesh.positions.size(), glm::vec3(1.0f));
-  attenuation_ = dynamic_buffer(ones.data(), ones.size() * sizeof(glm::vec3));
+  attenuation_ = create_buffer(ones.data(), ones.size() * sizeof(glm::vec3), GL_DYNAMIC_STORAGE_BIT);
   attach_vec3_attribute(vao, 2, attenuation_.get());
   indices_ = create_buffer(mesh.indices.data(), mesh.indices.size() * sizeof(std::uint32_t));
   glVertexArrayElementBuffer(vao, indices_.get());

@@ -15,6 +15,7 @@
 namespace lumar {
 
 class LineShadows;
+class ObjectShadows;
 class IrradianceVolume;
 
 class Compositor {
@@ -33,10 +34,13 @@ class Compositor {
   // Moves object `index` (manifest order): the renderer and the shadow lines follow; the
   // shadows are recomputed in the next composite() only if a pose changed.
   void set_object_pose(std::size_t index, const glm::dmat4& T_world_model);
-  // Soft shadows of the objects on the receivers (docs/shadows.md); on by default.
+  // Soft shadows of the objects on the receivers and, with two objects or more, on each
+  // other (docs/shadows.md); on by default.
   void set_shadows_enabled(bool on);
   // The shadow lines, or nullptr when the scene has no receivers.
   const LineShadows* shadows() const { return shadows_.get(); }
+  // The objects' shadows on each other, or nullptr with fewer than two objects.
+  const ObjectShadows* object_shadows() const { return object_shadows_.get(); }
 
   gl::Renderer& renderer() { return *renderer_; }
   const CameraIntrinsics& output_camera() const { return camera_; }
@@ -56,7 +60,8 @@ class Compositor {
   void build_shadows(const Scene& scene);
   std::vector<glm::dvec3> object_points_;
   std::shared_ptr<LineShadows> shadows_;  // shared_ptr: LineShadows is incomplete here
-  bool shadows_enabled_ = true, shadows_uploaded_ = false;
+  std::shared_ptr<ObjectShadows> object_shadows_;
+  bool shadows_enabled_ = true, shadows_uploaded_ = false, object_shadows_uploaded_ = false;
 };
 
 }  // namespace lumar

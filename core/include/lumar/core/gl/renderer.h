@@ -63,6 +63,10 @@ class Renderer {
   int add_object(const Mesh& mesh_model);
   void set_object_pose(int id, const glm::dmat4& T_world_model);
   void set_object_material(int id, const glm::vec3& albedo, const SH9& irradiance_sh);
+  // Per vertex (mesh order), the share of the light the object still gets when the
+  // other objects block some of it (object_shadows.h): multiplies its irradiance.
+  // 1 until set; throws InputError unless there is one value per vertex.
+  void set_object_light_attenuation(int id, std::span<const glm::vec3> attenuation);
   // Shade every object per pixel from this irradiance volume (uploaded as textures;
   // core/irradiance_volume.h) instead of its SH9; nullptr goes back to SH9.
   void set_irradiance_volume(const IrradianceVolume* volume);
