@@ -3,6 +3,7 @@
 #include <embree3/rtcore.h>
 
 #include <algorithm>
+#include <cstddef>
 #include <numeric>
 #include <opencv2/core.hpp>
 #include <string>
@@ -160,26 +161,18 @@ bool OccluderMesh::occluded(const glm::vec3& origin, const glm::vec3& dir, float
   return r.tfar < 0.0f;
 }
 
-void OccluderMesh::occluded(std::size_t n, const glm::vec3* origins, const glm::vec3* dirs, float t_far,
-                            std::uint8_t* blocked) const {
+static_assert(sizeof(OccluderMesh::StreamRay) == sizeof(RTCRay));
+static_assert(offsetof(OccluderMesh::StreamRay, origin) == offsetof(RTCRay, org_x));
+static_assert(offsetof(OccluderMesh::StreamRay, t_near) == offsetof(RTCRay, tnear));
+static_assert(offsetof(OccluderMesh::StreamRay, dir) == offsetof(RTCRay, dir_x));
+static_assert(offsetof(OccluderMesh::StreamRay, t_far) == offsetof(RTCRay, tfar));
+static_assert(offsetof(OccluderMesh::StreamRay, flags) == offsetof(RTCRay, flags));
+
+void OccluderMesh::occluded(StreamRay* rays, std::size_t n) const {
   RTCIntersectContext context;
   rtcInitIntersectContext(&context);
   context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
-  constexpr std::size_t kChunk = 256;
-  RTCRay chunk[kChunk];
-  for (std::size_t first = 0; first < n; first += kChunk) {
-    const std::size_t m = std::min(kChunk, n - first);
-    for (std::size_t k = 0; k < m; ++k) {
-      const glm::vec3 &o = origins[first + k], &d = dirs[first + k];
-      RTCRay& r = chunk[k];
-      r = RTCRay{};
-      r.org_x = o.x, r.org_y = o.y, r.org_z = o.z, r.tnear = 0.0f;
-      r.dir_x = d.x, r.dir_y = d.y, r.dir_z = d.z, r.tfar = t_far;
-      r.mask = 0xFFFFFFFFu;
-    }
-    rtcOccluded1M(static_cast<RTCScene>(scene_), &context, chunk, unsigned(m), sizeof(RTCRay));
-    for (std::size_t k = 0; k < m; ++k) blocked[first + k] = chunk[k].tfar < 0.0f ? 1 : 0;
-  }
+  rtcOccluded1M(static_cast<RTCScene>(scene_), &context, reinterpret_cast<RTCRay*>(rays), unsigned(n), sizeof(RTCRay));
 }
 
 }  // namespace lumar

@@ -243,14 +243,13 @@ void LineShadows::trace(const Object& o) {
 void LineShadows::trace_all(const Object& o) {
   const float t_far = shadow_ray_t_far(lines_.distant);
   constexpr std::size_t kChunk = 256;
-  glm::vec3 origins[kChunk], dirs[kChunk];
+  OccluderMesh::StreamRay chunk[kChunk];
   std::uint32_t which[kChunk];
-  std::uint8_t blocked[kChunk];
   std::size_t n = 0;
   const auto flush = [&] {
-    o.mesh->occluded(n, origins, dirs, t_far, blocked);
+    o.mesh->occluded(chunk, n);
     for (std::size_t k = 0; k < n; ++k)
-      if (blocked[k]) all_blocked_[which[k]] = 1;
+      if (chunk[k].t_far < 0.0f) all_blocked_[which[k]] = 1;
     n = 0;
   };
   for (std::uint32_t li = 0; li < lines_.lines.size(); ++li) {
@@ -258,7 +257,9 @@ void LineShadows::trace_all(const Object& o) {
     const ShadowLine& l = lines_.lines[li];
     const glm::vec3& p = o.origin_model[l.receiver];
     const glm::vec3& s = o.sample_model[l.sample];
-    origins[n] = p, dirs[n] = lines_.distant ? s : s - p;
+    OccluderMesh::StreamRay& r = chunk[n];
+    r = OccluderMesh::StreamRay{};
+    r.origin = p, r.dir = lines_.distant ? s : s - p, r.t_far = t_far;
     which[n++] = li;
     if (n == kChunk) flush();
   }

@@ -29,10 +29,19 @@ class OccluderMesh {
 
   // Whether the segment origin + t dir, t in (0, t_far), meets a triangle (model space).
   bool occluded(const glm::vec3& origin, const glm::vec3& dir, float t_far) const;
-  // The same for n rays at once, traced as one coherent stream (Embree's rtcOccluded1M):
-  // blocked[i] = 1 or 0.
-  void occluded(std::size_t n, const glm::vec3* origins, const glm::vec3* dirs, float t_far,
-                std::uint8_t* blocked) const;
+
+  // A ray of a stream, laid out as Embree's RTCRay (checked where it is traced), so that
+  // a stream is traced where it was filled, without a copy.
+  struct StreamRay {
+    glm::vec3 origin{0.0f};
+    float t_near = 0.0f;
+    glm::vec3 dir{0.0f};
+    float time = 0.0f;
+    float t_far = 0.0f;  // after occluded(): negative when the ray is blocked
+    std::uint32_t mask = ~0u, id = 0, flags = 0;
+  };
+  // Many rays at once, as one coherent stream (Embree's rtcOccluded1M).
+  void occluded(StreamRay* rays, std::size_t n) const;
 
  private:
   void* scene_ = nullptr;  // RTCScene: Embree stays out of this header
