@@ -292,6 +292,8 @@ int main(int argc, char** argv) {
       instanced ? instanced->time_ms : 0.0, speedup_instanced, s.receivers.positions.size(), built.at(1).precompute_ms, big.precompute_ms);
   if (quick) {
     fmt::print("LUMAR_SHADOW_BENCH_QUICK: no reference, so the chart and JSON are left as they are\n");
+  } else if (report.entries.size() != errors.size()) {
+    fmt::print("a filtered run: the chart and JSON are left as they are\n");
   } else {
     report.save(bench::results_dir());
     // The chart also lives beside the shadow docs.
