@@ -72,12 +72,22 @@ cv::Mat room_video(Compositor& compositor, const CameraIntrinsics& camera, const
   return video;
 }
 
-TEST(ShadowOverlay, VideoDarkensWhereTheLinesSayAndNowhereElse) {
-  context();
+// The sample scene seen from frame 15 of the sample recording, with a current context.
+struct SampleView {
   CameraIntrinsics camera;
   Pose pose;
-  recording_view(15, camera, pose);
-  Scene scene = load_scene(test::source_dir() / "data/scenes/room/scene.json");
+  Scene scene;
+};
+SampleView sample_view() {
+  context();
+  SampleView v;
+  recording_view(15, v.camera, v.pose);
+  v.scene = load_scene(test::source_dir() / "data/scenes/room/scene.json");
+  return v;
+}
+
+TEST(ShadowOverlay, VideoDarkensWhereTheLinesSayAndNowhereElse) {
+  auto [camera, pose, scene] = sample_view();
   // Lift the figurine a little so that its shadow is a visible patch, not only contact.
   const glm::dmat4 T = glm::translate(glm::dmat4(1.0), glm::dvec3(0, 0.12, 0)) * scene.objects[0].T_world_model;
   Compositor compositor(scene, camera, cv::Mat(), cv::Mat());
@@ -153,11 +163,7 @@ TEST(ShadowOverlay, VideoDarkensWhereTheLinesSayAndNowhereElse) {
 // one takes light from the lower one's vertices, the lower one's pixels darken by that
 // ratio (against the same frame with shadows off).
 TEST(ShadowOverlay, ObjectsShadowEachOther) {
-  context();
-  CameraIntrinsics camera;
-  Pose pose;
-  recording_view(15, camera, pose);
-  Scene scene = load_scene(test::source_dir() / "data/scenes/room/scene.json");
+  auto [camera, pose, scene] = sample_view();
   SceneObject upper = scene.objects[0];
   upper.name = "upper";
   upper.T_world_model = glm::translate(glm::dmat4(1.0), glm::dvec3(0.12, 0.32, -0.1)) * upper.T_world_model;
