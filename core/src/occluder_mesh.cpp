@@ -18,9 +18,9 @@ namespace {
 // their shadow cones hugs a figurine far better than one box. Each cut is the one (any
 // axis, any triangle, at least a quarter of the triangles on each side) that minimises
 // the two halves' summed box area. On the figurine (bench_shadows, 1 M lines): median
-// cuts along the longest side, 8 pieces 47 k candidates per frame, 16 pieces 38 k, 32
-// pieces 31 k, but each doubling cost more in cones and footprints than it saved in rays;
-// area-minimising cuts, 8 pieces 31 k (16 pieces: 29 k, slower overall).
+// cuts along the longest side, 8 pieces 47 k candidates per frame; area-minimising cuts,
+// 8 pieces 30 k, 16 pieces 27 k, 64 pieces 22 k, but each doubling cost more in cones
+// and footprints than it saved in rays (docs/shadows.md).
 constexpr int kPartDepth = 3;
 constexpr std::size_t kMinShare = 4;
 constexpr int kSplitSteps = 16;

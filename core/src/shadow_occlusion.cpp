@@ -227,8 +227,8 @@ void LineShadows::cull(const Object& o, std::uint32_t sample) {
 }
 
 // Candidates traced in model space, one ray at a time: on the figurine, Embree's
-// single-ray traversal took ~95 ns per candidate, 8-ray packets of neighbouring
-// candidates ~190 ns, its ray stream (rtcOccluded1M, coherent) ~200 ns.
+// single-ray traversal took ~125 ns per candidate; packets and streams were slower
+// (docs/shadows.md lists what was tried).
 void LineShadows::trace(const Object& o) {
   const float t_far = shadow_ray_t_far(lines_.distant);
   for (const Candidate& c : candidates_) {
