@@ -8,6 +8,8 @@
 #include <glm/gtc/matrix_transform.hpp>
 #include <glm/gtc/quaternion.hpp>
 #include <random>
+#include <string>
+#include <vector>
 
 #include "lumar/core/scene.h"
 #include "lumar/core/shadow_cone.h"
@@ -132,10 +134,10 @@ TEST(ShadowReceiverGrid, EveryReceiverInItsBucket) {
   }
 }
 
-// Poses the object, updates with culling on and off; returns how many lines tracing all
-// of them found blocked. Every one of them must be a candidate of the culled update.
-std::size_t check_pose(LineShadows& shadows, const glm::dmat4& T, const char* what) {
-  shadows.set_object_pose(0, T);
+// Updates with culling on and off; returns the lines tracing all of them found blocked
+// (ascending). Every one of them must be a candidate of the culled update, and the culled
+// update must find exactly them.
+std::vector<std::uint32_t> culled_matches_all(LineShadows& shadows, const std::string& what) {
   shadows.set_culling(true);
   shadows.update();
   std::vector<std::uint32_t> traced = shadows.traced_lines(), culled_blocked = shadows.blocked_lines();
@@ -153,7 +155,13 @@ std::size_t check_pose(LineShadows& shadows, const glm::dmat4& T, const char* wh
   for (std::size_t i = 0; i < culled.size(); ++i) diff = std::max(diff, glm::length(culled[i] - shadows.attenuation()[i]));
   EXPECT_LT(diff, 1e-5f) << what;
   EXPECT_LT(traced.size(), shadows.lines().lines.size()) << what;
-  return blocked.size();
+  return blocked;
+}
+
+// Poses the (first) object and checks the culled update; returns how many lines are blocked.
+std::size_t check_pose(LineShadows& shadows, const glm::dmat4& T, const char* what) {
+  shadows.set_object_pose(0, T);
+  return culled_matches_all(shadows, what).size();
 }
 
 // The emitter sample point with the most flux: lines to it shadow the most.
@@ -225,22 +233,10 @@ TEST(ShadowCulling, TwoObjectsCountEachBlockedLineOnce) {
     both.set_object_pose(1, T_ball);
     ball_only.set_object_pose(0, T_ball);
     ball_only.update();
-    both.set_culling(true);
-    both.update();
-    std::vector<std::uint32_t> culled = both.blocked_lines(), traced = both.traced_lines();
-    const auto culled_att = both.attenuation();
-    both.set_culling(false);
-    both.update();
-    const std::vector<std::uint32_t>& all = both.blocked_lines();
-    std::sort(culled.begin(), culled.end());
-    std::sort(traced.begin(), traced.end());
+    // The culled update finds each line once, however many objects block it.
+    const std::vector<std::uint32_t> all = culled_matches_all(both, "two objects, pose " + std::to_string(k));
     EXPECT_LT(all.size() + 200, fig_only.blocked_lines().size() + ball_only.blocked_lines().size())
         << "pose " << k << ": the objects must share blocked lines for this test";
-    EXPECT_EQ(culled, all) << "pose " << k;  // each once
-    EXPECT_TRUE(std::includes(traced.begin(), traced.end(), all.begin(), all.end()));
-    float diff = 0;
-    for (std::size_t i = 0; i < culled_att.size(); ++i) diff = std::max(diff, glm::length(culled_att[i] - both.attenuation()[i]));
-    EXPECT_LT(diff, 1e-5f) << "pose " << k;
     std::printf("two objects, pose %d: %zu lines blocked (figurine alone %zu, ball alone %zu)\n", k, all.size(),
                 fig_only.blocked_lines().size(), ball_only.blocked_lines().size());
   }
