@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cstddef>
+#include <map>
 #include <numeric>
 #include <opencv2/core.hpp>
 #include <string>
@@ -105,6 +106,19 @@ void split_parts(const Mesh& m, std::vector<std::uint32_t>& tris, std::size_t b,
   split_parts(m, tris, mid, e, depth - 1, out);
 }
 
+// A single ray's context that also learns which triangle blocked it: Embree calls the
+// context filter on each hit it finds (the scene is flagged for it), and an occlusion
+// ray stops at the first hit it keeps.
+struct BlockerContext {
+  RTCIntersectContext context;
+  std::uint32_t triangle;
+};
+
+void record_blocker(const RTCFilterFunctionNArguments* args) {
+  if (args->N == 1 && args->valid[0] != 0)
+    reinterpret_cast<BlockerContext*>(args->context)->triangle = RTCHitN_primID(args->hit, 1, 0);
+}
+
 void report_embree_error(void*, RTCError code, const char* message) {
   if (code != RTC_ERROR_NONE) throw RuntimeError(std::string("Embree (shadow meshes): ") + (message ? message : "error"));
 }
@@ -122,11 +136,34 @@ RTCDevice bvh_device() {
 
 }  // namespace
 
-OccluderMesh::OccluderMesh(const Mesh& m) {
-  if (m.triangle_count() == 0) throw InputError("OccluderMesh: the mesh has no triangles");
+OccluderMesh::OccluderMesh(const Mesh& model) {
+  if (model.triangle_count() == 0) throw InputError("OccluderMesh: the mesh has no triangles");
+  // Triangles in Morton order of their centroids: neighbours on the mesh are mostly
+  // neighbours in memory, for blocked_near's walks (the triangle ids are Embree's too).
+  Mesh m;
+  m.positions = model.positions;
+  {
+    const auto [lo, hi] = model.bounds();
+    const glm::vec3 scale = 1023.0f / glm::max(hi - lo, glm::vec3(1e-9f));
+    std::vector<std::pair<std::uint32_t, std::uint32_t>> keyed(model.triangle_count());
+    for (std::uint32_t t = 0; t < model.triangle_count(); ++t) {
+      const glm::vec3 c = (model.positions[model.indices[3 * t]] + model.positions[model.indices[3 * t + 1]] +
+                           model.positions[model.indices[3 * t + 2]]) / 3.0f;
+      const glm::uvec3 q = glm::uvec3(glm::clamp((c - lo) * scale, glm::vec3(0.0f), glm::vec3(1023.0f)));
+      std::uint32_t key = 0;
+      for (int bit = 9; bit >= 0; --bit)
+        for (int a = 0; a < 3; ++a) key = (key << 1) | ((q[a] >> bit) & 1u);
+      keyed[t] = {key, t};
+    }
+    std::sort(keyed.begin(), keyed.end());
+    for (const auto& [key, t] : keyed)
+      for (int k = 0; k < 3; ++k) m.indices.push_back(model.indices[3 * t + std::uint32_t(k)]);
+  }
+
   RTCDevice device = bvh_device();
   RTCScene scene = rtcNewScene(device);
   rtcSetSceneBuildQuality(scene, RTC_BUILD_QUALITY_HIGH);  // built once, traced every frame
+  rtcSetSceneFlags(scene, RTC_SCENE_FLAG_CONTEXT_FILTER_FUNCTION);  // record_blocker
   RTCGeometry geom = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
   rtcSetGeometryBuildQuality(geom, RTC_BUILD_QUALITY_HIGH);
   auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
@@ -145,20 +182,80 @@ OccluderMesh::OccluderMesh(const Mesh& m) {
   std::iota(tris.begin(), tris.end(), 0u);
   split_parts(m, tris, 0, tris.size(), kPartDepth, pieces_);
   whole_ = bounding_box(m.positions);
+
+  triangles_.resize(m.triangle_count());
+  std::map<std::pair<std::uint32_t, std::uint32_t>, std::vector<std::pair<std::uint32_t, int>>> edges;
+  for (std::uint32_t t = 0; t < m.triangle_count(); ++t) {
+    const std::uint32_t* c = &m.indices[3 * t];
+    Triangle& tri = triangles_[t];
+    tri.v0 = m.positions[c[0]];
+    tri.e1 = m.positions[c[1]] - tri.v0, tri.e2 = m.positions[c[2]] - tri.v0;
+    tri.area2 = glm::length(glm::cross(tri.e1, tri.e2));
+    for (int k = 0; k < 3; ++k) {
+      const std::uint32_t x = c[(k + 1) % 3], y = c[(k + 2) % 3];
+      edges[{std::min(x, y), std::max(x, y)}].push_back({t, k});
+    }
+  }
+  for (const auto& [edge, sides] : edges) {
+    if (sides.size() != 2) continue;
+    triangles_[sides[0].first].across[std::size_t(sides[0].second)] = sides[1].first;
+    triangles_[sides[1].first].across[std::size_t(sides[1].second)] = sides[0].first;
+  }
 }
 
 OccluderMesh::~OccluderMesh() { rtcReleaseScene(static_cast<RTCScene>(scene_)); }
 
-bool OccluderMesh::occluded(const glm::vec3& origin, const glm::vec3& dir, float t_far) const {
-  RTCIntersectContext context;
-  rtcInitIntersectContext(&context);
-  context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+bool OccluderMesh::occluded(const glm::vec3& origin, const glm::vec3& dir, float t_far, std::uint32_t* blocker) const {
+  BlockerContext c;
+  rtcInitIntersectContext(&c.context);
+  c.context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+  if (blocker) c.context.filter = record_blocker;
+  c.triangle = kNoTriangle;
   RTCRay r{};
   r.org_x = origin.x, r.org_y = origin.y, r.org_z = origin.z, r.tnear = 0.0f;
   r.dir_x = dir.x, r.dir_y = dir.y, r.dir_z = dir.z, r.tfar = t_far;
   r.mask = 0xFFFFFFFFu;
-  rtcOccluded1(static_cast<RTCScene>(scene_), &context, &r);
+  rtcOccluded1(static_cast<RTCScene>(scene_), &c.context, &r);
+  if (blocker) *blocker = c.triangle;
   return r.tfar < 0.0f;
+}
+
+bool OccluderMesh::blocked_near(const glm::vec3& o, const glm::vec3& d, float t_far, std::uint32_t& triangle) const {
+  // Margins (barycentric, and along the segment) far above float error: a hit here is a
+  // hit for Embree's watertight test too. Rays within ~0.06 degrees of a triangle's plane
+  // are left to Embree.
+  constexpr float kInside = 1e-4f, kGrazing = 1e-3f;
+  // At most kSteps steps, and none towards a crossing more than kFar triangle widths
+  // away: a line that slid off a thin part (it may still cross the mesh elsewhere) fails
+  // early and goes to Embree.
+  constexpr int kSteps = 4;
+  constexpr float kFar = 3.0f;
+  const float grazing2 = kGrazing * kGrazing * glm::dot(d, d);
+  std::uint32_t t = triangle;
+  for (int step = 0; step <= kSteps && t < triangles_.size(); ++step) {
+    const Triangle& tri = triangles_[t];
+    // Moeller-Trumbore without the division: the weights below are the barycentric
+    // weights of the line's crossing with the triangle's plane, times |det|.
+    const glm::vec3 p = glm::cross(d, tri.e2);
+    const float det = glm::dot(tri.e1, p);
+    if (!(det * det > grazing2 * tri.area2 * tri.area2)) return false;
+    const float sign = det > 0.0f ? 1.0f : -1.0f, scale = det * sign;
+    const glm::vec3 s = o - tri.v0;
+    const glm::vec3 q = glm::cross(s, tri.e1);
+    const float u = sign * glm::dot(s, p), v = sign * glm::dot(d, q), w = scale - u - v;  // corners 1, 2, 0
+    const float inside = kInside * scale;
+    if (u >= inside && v >= inside && w >= inside) {
+      const float at = sign * glm::dot(tri.e2, q);
+      if (!(at >= inside * t_far && at <= (scale - inside) * t_far)) return false;
+      triangle = t;
+      return true;
+    }
+    // Step across the edge opposite the most negative weight, towards the crossing.
+    const int k = w <= u && w <= v ? 0 : (u <= v ? 1 : 2);
+    if (std::min({u, v, w}) < -kFar * scale) return false;
+    t = tri.across[std::size_t(k)];
+  }
+  return false;
 }
 
 static_assert(sizeof(OccluderMesh::StreamRay) == sizeof(RTCRay));

@@ -211,6 +211,46 @@ TEST(ShadowCulling, CandidatesContainEveryBlockedLine) {
   EXPECT_GT(blocked, 1000u);
 }
 
+// The figurine gliding a few millimetres per frame: most lines it blocked in the last
+// frame are proven blocked again by walking over its mesh from last frame's blocker,
+// without Embree, and the result stays exactly that of tracing every line.
+TEST(ShadowCulling, SlowMotionReusesLastFramesBlockers) {
+  const test::SampleRoomLines room = test::sample_room_lines(900);
+  const auto& fig = room.figurine();
+  LineShadows shadows(room.lines), oracle(room.lines);
+  oracle.set_culling(false);
+  const auto pose = [&](int k) {
+    return glm::translate(glm::dmat4(1.0), glm::dvec3(0.004 * k, 0.12, 0.003 * k)) *
+           glm::rotate(glm::dmat4(1.0), 0.01 * k, glm::dvec3(0, 1, 0)) * fig.T_world_model;
+  };
+  shadows.add_object(fig.model, pose(0));
+  oracle.add_object(fig.model, pose(0));
+  for (int k = 0; k < 8; ++k) {
+    shadows.set_object_pose(0, pose(k));
+    oracle.set_object_pose(0, pose(k));
+    shadows.update();
+    oracle.update();
+    std::vector<std::uint32_t> blocked = shadows.blocked_lines();
+    std::sort(blocked.begin(), blocked.end());
+    EXPECT_EQ(blocked, oracle.blocked_lines()) << "frame " << k;
+    const ShadowFrameStats& st = shadows.stats();
+    std::printf("frame %d: %zu lines blocked, %zu of them proven by walking\n", k, st.lines_blocked, st.blocked_near);
+    if (k == 0) EXPECT_EQ(st.blocked_near, 0u);  // no last frame
+    else EXPECT_GT(double(st.blocked_near), 0.6 * double(st.lines_blocked)) << "frame " << k;
+  }
+  // A jump of 0.3 m: no walks (they would all fail), the same lines as tracing all.
+  const glm::dmat4 far = glm::translate(glm::dmat4(1.0), glm::dvec3(-0.3, 0.0, 0.0)) * pose(7);
+  shadows.set_object_pose(0, far);
+  oracle.set_object_pose(0, far);
+  shadows.update();
+  oracle.update();
+  std::vector<std::uint32_t> blocked = shadows.blocked_lines();
+  std::sort(blocked.begin(), blocked.end());
+  EXPECT_EQ(blocked, oracle.blocked_lines()) << "after the jump";
+  EXPECT_GT(blocked.size(), 1000u);
+  EXPECT_EQ(shadows.stats().blocked_near, 0u);
+}
+
 TEST(ShadowCulling, TwoObjectsCountEachBlockedLineOnce) {
   const test::SampleRoomLines room = test::sample_room_lines(900);
   const ShadowLines& lines = room.lines;

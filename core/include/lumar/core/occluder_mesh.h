@@ -27,8 +27,22 @@ class OccluderMesh {
   const std::array<glm::vec3, 8>& whole() const { return whole_; }
   const std::vector<std::array<glm::vec3, 8>>& pieces() const { return pieces_; }
 
+  static constexpr std::uint32_t kNoTriangle = ~std::uint32_t(0);
+
   // Whether the segment origin + t dir, t in (0, t_far), meets a triangle (model space).
-  bool occluded(const glm::vec3& origin, const glm::vec3& dir, float t_far) const;
+  // If it does and `blocker` is given, *blocker is set to a triangle that it meets.
+  bool occluded(const glm::vec3& origin, const glm::vec3& dir, float t_far, std::uint32_t* blocker = nullptr) const;
+  // Whether the segment surely meets a triangle found by walking over the mesh from
+  // `triangle` towards the segment (a few steps across edges); the one it meets is
+  // written back to `triangle`. A cheap proof that a line is blocked when a nearby line
+  // (the same line, last frame) was blocked by `triangle`. A hit must lie inside a
+  // triangle by a margin, so every line it proves blocked, Embree finds blocked too;
+  // false means "not proven", and Embree decides.
+  bool blocked_near(const glm::vec3& origin, const glm::vec3& dir, float t_far, std::uint32_t& triangle) const;
+  // Starts loading a triangle that blocked_near will soon start from (a hint).
+  void prefetch(std::uint32_t triangle) const {
+    if (triangle < triangles_.size()) __builtin_prefetch(&triangles_[triangle]);
+  }
 
   // A ray of a stream, laid out as Embree's RTCRay (checked where it is traced), so that
   // a stream is traced where it was filled, without a copy.
@@ -45,6 +59,14 @@ class OccluderMesh {
 
  private:
   void* scene_ = nullptr;  // RTCScene: Embree stays out of this header
+  struct alignas(64) Triangle {  // one cache line
+    glm::vec3 v0, e1, e2;         // a corner and the edges from it
+    float area2 = 0.0f;           // |e1 x e2|
+    // Across edge k (the edge opposite corner k): the triangle sharing it, or
+    // kNoTriangle (a border, or an edge shared by more than two triangles).
+    std::array<std::uint32_t, 3> across{kNoTriangle, kNoTriangle, kNoTriangle};
+  };
+  std::vector<Triangle> triangles_;
   std::array<glm::vec3, 8> whole_{};
   std::vector<std::array<glm::vec3, 8>> pieces_;
 };

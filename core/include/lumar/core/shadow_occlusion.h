@@ -6,8 +6,11 @@
 // of each object's mesh are intersected with the receiver grids' planes
 // (shadow_receiver_grid.h) and scanned row by row: only the receivers in a footprint are
 // looked at (and tested against the cone); every other line costs nothing. Only the
-// candidates are traced, in the object's model space against its own BVH (built once).
-// Exact: a blocked line is always a candidate. Nothing moved since the last update: no work.
+// candidates are tested, in the object's model space: a line the object blocked at the
+// last update first walks over the mesh from the triangle that blocked it then (a few
+// steps, OccluderMesh::blocked_near); the rest are traced against its own BVH (built
+// once). Exact: a blocked line is always a candidate, and a walk only proves what Embree
+// would find. Nothing moved since the last update: no work.
 #include <array>
 #include <cstddef>
 #include <cstdint>
@@ -29,6 +32,7 @@ struct ShadowFrameStats {
   std::size_t receivers_tested = 0;  // receivers in a footprint, tested against the cone
   std::size_t rays_traced = 0;   // candidate lines traced (culling off: every line)
   std::size_t lines_blocked = 0;
+  std::size_t blocked_near = 0;  // blocked lines proven by last frame's blocker's neighbourhood, without Embree
   double cull_ms = 0, trace_ms = 0;  // CPU time (calling thread) of the culling and of the ray tracing
 };
 
@@ -68,10 +72,17 @@ class LineShadows {
     // This frame, model space: every receiver's ray origin, every sample's line end
     // (distant: the line's direction and length).
     std::vector<glm::vec3> origin_model, sample_model;
+    // The lines it blocked at the last update (at pose T_blocked), ascending, with a
+    // triangle that blocked each: this frame, a line's first test is a walk from it.
+    struct Blocked {
+      std::uint32_t line, triangle;
+    };
+    std::vector<Blocked> blocked, next_blocked;
+    glm::dmat4 T_blocked{1.0};
   };
   void place(Object& o, const glm::dmat4& T_world_model);
   void cull(const Object& o, std::uint32_t sample);
-  void trace(const Object& o);
+  void trace(Object& o);
   void trace_all(const Object& o);
 
   ShadowLines lines_;
