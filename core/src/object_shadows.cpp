@@ -1,10 +1,12 @@
 #include "lumar/core/object_shadows.h"
 
 #include <tbb/parallel_for.h>
+#include <xmmintrin.h>
 
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <cmath>
 #include <numeric>
 #include <string>
 
@@ -47,12 +49,60 @@ bool box_outside(const ShadowCone& cone, const glm::vec3& lo, const glm::vec3& h
 
 }  // namespace
 
-ObjectShadows::ObjectShadows(const Emitters& emitters) : samples_(emitters.samples), distant_(emitters.distant) {}
+ObjectShadows::ObjectShadows(const Emitters& emitters) : samples_(emitters.samples), distant_(emitters.distant) {
+  sample_stride_ = (samples_.size() + 3) / 4 * 4;
+  sample_rows_.assign(9 * sample_stride_, 0.0f);
+  for (std::size_t i = 0; i < sample_stride_; ++i) {
+    float* row = &sample_rows_[i];
+    const std::size_t S = sample_stride_;
+    if (i >= samples_.size()) {  // padding: far away, facing nothing, no flux
+      row[0] = row[S] = row[2 * S] = 1e6f;
+      continue;
+    }
+    const EmitterPoint& e = samples_[i];
+    for (int a = 0; a < 3; ++a) {
+      row[std::size_t(a) * S] = e.position[a];
+      row[std::size_t(3 + a) * S] = e.normal[a];
+      row[std::size_t(6 + a) * S] = e.flux[a];
+    }
+  }
+}
 
+// The sum of emitter_irradiance over the samples (the same formula), four samples at a
+// time (SSE) over the structure of arrays: it is most of an update's work when an object
+// moves, since every shadowed vertex of it needs it.
 glm::vec3 ObjectShadows::unshadowed(const glm::vec3& x, const glm::vec3& n) const {
-  glm::vec3 sum(0.0f);
-  for (const EmitterPoint& e : samples_) sum += emitter_irradiance(e, distant_, x, n);
-  return sum;
+  const std::size_t S = sample_stride_;
+  const float* row = sample_rows_.data();
+  const __m128 zero = _mm_setzero_ps(), nx = _mm_set1_ps(n.x), ny = _mm_set1_ps(n.y), nz = _mm_set1_ps(n.z);
+  const __m128 x0 = _mm_set1_ps(x.x), x1 = _mm_set1_ps(x.y), x2 = _mm_set1_ps(x.z);
+  const __m128 tiny = _mm_set1_ps(1e-8f), cap = _mm_set1_ps(1e-4f);
+  __m128 r = zero, g = zero, b = zero;
+  for (std::size_t i = 0; i < S; i += 4) {
+    const auto at = [&](int k) { return _mm_loadu_ps(row + std::size_t(k) * S + i); };
+    __m128 w;
+    if (distant_) {
+      w = _mm_max_ps(zero, _mm_add_ps(_mm_add_ps(_mm_mul_ps(nx, at(0)), _mm_mul_ps(ny, at(1))), _mm_mul_ps(nz, at(2))));
+    } else {
+      const __m128 dx = _mm_sub_ps(at(0), x0), dy = _mm_sub_ps(at(1), x1), dz = _mm_sub_ps(at(2), x2);
+      const __m128 r2 = _mm_add_ps(_mm_add_ps(_mm_mul_ps(dx, dx), _mm_mul_ps(dy, dy)), _mm_mul_ps(dz, dz));
+      // cos_x cos_e / max(r^2, cap) = (n.d)(-n_e.d) / (r^2 max(r^2, cap)): no square root.
+      const __m128 along_n = _mm_add_ps(_mm_add_ps(_mm_mul_ps(nx, dx), _mm_mul_ps(ny, dy)), _mm_mul_ps(nz, dz));
+      const __m128 along_e = _mm_sub_ps(
+          zero, _mm_add_ps(_mm_add_ps(_mm_mul_ps(at(3), dx), _mm_mul_ps(at(4), dy)), _mm_mul_ps(at(5), dz)));
+      const __m128 ok = _mm_and_ps(_mm_and_ps(_mm_cmpgt_ps(along_n, zero), _mm_cmpgt_ps(along_e, zero)),
+                                   _mm_cmpgt_ps(r2, tiny));
+      const __m128 q = _mm_div_ps(_mm_mul_ps(along_n, along_e), _mm_mul_ps(r2, _mm_max_ps(r2, cap)));
+      w = _mm_and_ps(ok, q);
+    }
+    r = _mm_add_ps(r, _mm_mul_ps(w, at(6)));
+    g = _mm_add_ps(g, _mm_mul_ps(w, at(7)));
+    b = _mm_add_ps(b, _mm_mul_ps(w, at(8)));
+  }
+  alignas(16) float sum[3][4];
+  _mm_store_ps(sum[0], r), _mm_store_ps(sum[1], g), _mm_store_ps(sum[2], b);
+  return {sum[0][0] + sum[0][1] + sum[0][2] + sum[0][3], sum[1][0] + sum[1][1] + sum[1][2] + sum[1][3],
+          sum[2][0] + sum[2][1] + sum[2][2] + sum[2][3]};
 }
 
 ObjectShadows::~ObjectShadows() = default;

@@ -95,6 +95,10 @@ class ObjectShadows {
   glm::vec3 unshadowed(const glm::vec3& x, const glm::vec3& n) const;
 
   std::vector<EmitterPoint> samples_;
+  // The samples again as a structure of arrays (position xyz, normal xyz, flux rgb; each
+  // row padded to a multiple of 4 with samples of no flux), for unshadowed()'s SIMD loop.
+  std::vector<float> sample_rows_;
+  std::size_t sample_stride_ = 0;
   bool distant_ = false;
   std::vector<Object> objects_;
   bool dirty_ = true;
