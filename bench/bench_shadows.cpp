@@ -241,17 +241,18 @@ int main(int argc, char** argv) {
       const glm::dmat4 beside = glm::translate(glm::dmat4(1.0), glm::dvec3(0.6, 0, 0.05));
       const int b = shadows.add_object(fig.model, beside * error_pose());
       int frame = 0;
-      std::size_t shadowed = 0, rays = 0, blocked = 0;
+      std::size_t shadowed = 0, rays = 0, blocked = 0, walked = 0;
       for (auto _ : state) {
         const glm::dvec3 step(0.01 * (frame++ % 6 + 1), 0, 0);
         shadows.set_object_pose(b, glm::translate(glm::dmat4(1.0), step) * beside * error_pose());
         shadows.update();
         shadowed += shadows.stats().vertices_shadowed, rays += shadows.stats().rays_traced;
-        blocked += shadows.stats().lines_blocked;
+        blocked += shadows.stats().lines_blocked, walked += shadows.stats().lines_walked;
       }
       state.counters["vertices_shadowed"] = double(shadowed) / double(state.iterations());
       state.counters["rays"] = double(rays) / double(state.iterations());
       state.counters["blocked"] = double(blocked) / double(state.iterations());
+      state.counters["walked"] = double(walked) / double(state.iterations());
     })->Unit(benchmark::kMillisecond)->MinTime(1.0);
   }
 

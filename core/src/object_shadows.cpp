@@ -216,10 +216,27 @@ void ObjectShadows::shade(Object& a, std::size_t self) {
     const std::size_t stride = 1 + objects_[bi].parts.size();
     for (std::size_t s = 0; s < S; ++s) near[bi * S + s] = !box_outside(cones_[bi][s * stride], a.lo, a.hi);
   }
-  std::atomic<std::size_t> tested{0}, traced{0}, blocked_lines{0}, shadowed{0};
+  // Per occluder: whether the last update's blockers may start walks, i.e. whether a's
+  // box moved at most kWalkReach across the occluder's mesh since.
+  a.blocked.resize(a.groups.size());
+  a.occluder_from_model.resize(objects_.size(), glm::dmat4(0.0));
+  std::vector<std::uint8_t> walk(objects_.size(), 0);
+  for (std::size_t bi = 0; bi < objects_.size(); ++bi) {
+    const glm::dmat4 now = glm::inverse(objects_[bi].T_world_model) * a.T_world_model;
+    double moved = 0.0;
+    for (const glm::vec3& c : a.box) {  // in world units: the occluder's may differ
+      const glm::dvec4 x = glm::inverse(a.T_world_model) * glm::dvec4(glm::dvec3(c), 1.0);
+      const glm::dvec4 then = objects_[bi].T_world_model * (a.occluder_from_model[bi] * x);
+      moved = std::max(moved, glm::length(glm::dvec3(c) - glm::dvec3(then)));
+    }
+    walk[bi] = moved <= OccluderMesh::kWalkReach;
+    a.occluder_from_model[bi] = now;
+  }
+  std::atomic<std::size_t> tested{0}, traced{0}, blocked_lines{0}, walked{0}, shadowed{0};
   tbb::parallel_for(
       tbb::blocked_range<std::size_t>(0, a.groups.size(), 1), [&](const tbb::blocked_range<std::size_t>& range) {
-        std::size_t n_tested = 0, n_traced = 0, n_blocked = 0, n_shadowed = 0;
+        std::size_t n_tested = 0, n_traced = 0, n_blocked = 0, n_walked = 0, n_shadowed = 0;
+        std::vector<Object::Blocked> next;
         // Per vertex of the group: blocked irradiance, last sample blocked (+1), any candidate.
         constexpr std::uint32_t kMax = kChunk * kGroup;
         glm::vec3 blocked[kMax];
@@ -232,6 +249,10 @@ void ObjectShadows::shade(Object& a, std::size_t self) {
           std::fill_n(blocked, count, glm::vec3(0.0f));
           std::fill_n(stamp, count, 0u);
           std::fill_n(candidate, count, false);
+          // Last update's blocked lines, merged with this one's in visiting order.
+          const std::vector<Object::Blocked>& last = a.blocked[gi];
+          std::size_t li = 0;
+          next.clear();
           for (std::uint32_t s = 0; s < S; ++s) {
             const EmitterPoint& e = samples_[s];
             for (std::size_t bi = 0; bi < objects_.size(); ++bi) {
@@ -265,11 +286,26 @@ void ObjectShadows::shade(Object& a, std::size_t self) {
                   const glm::vec3 d =
                       distant_ ? distant_model : R * (emitter_line_end(e, distant_, a.origin[k]) - a.origin[k]);
                   ++n_traced;
-                  if (b.mesh->occluded(p, d, t_far)) stamp[j] = s + 1, blocked[j] += E, ++n_blocked;
+                  const auto before = [&](const Object::Blocked& x) {
+                    return x.sample != s ? x.sample < s : x.occluder != bi ? x.occluder < bi : x.vertex < k;
+                  };
+                  while (li < last.size() && before(last[li])) ++li;
+                  std::uint32_t triangle = OccluderMesh::kNoTriangle;
+                  if (walk[bi] && li < last.size() && last[li].sample == s && last[li].occluder == bi &&
+                      last[li].vertex == k)
+                    triangle = last[li].triangle;
+                  bool hit = b.mesh->blocked_near(p, d, t_far, triangle);
+                  n_walked += hit;
+                  if (!hit) hit = b.mesh->occluded(p, d, t_far, &triangle);
+                  if (hit) {
+                    stamp[j] = s + 1, blocked[j] += E, ++n_blocked;
+                    next.push_back({s, std::uint32_t(bi), k, triangle});
+                  }
                 }
               }
             }
           }
+          a.blocked[gi].swap(next);
           // Only vertices with a blocked line need their unshadowed irradiance.
           for (std::uint32_t j = 0; j < count; ++j) {
             if (!candidate[j] || !(max_channel(blocked[j]) > 0)) continue;
@@ -284,10 +320,11 @@ void ObjectShadows::shade(Object& a, std::size_t self) {
             if (ratio.r < 1.0f || ratio.g < 1.0f || ratio.b < 1.0f) ++n_shadowed;
           }
         }
-        tested += n_tested, traced += n_traced, blocked_lines += n_blocked, shadowed += n_shadowed;
+        tested += n_tested, traced += n_traced, blocked_lines += n_blocked, walked += n_walked;
+        shadowed += n_shadowed;
       });
   stats_.lines_tested += tested, stats_.rays_traced += traced;
-  stats_.lines_blocked += blocked_lines, stats_.vertices_shadowed += shadowed;
+  stats_.lines_blocked += blocked_lines, stats_.lines_walked += walked, stats_.vertices_shadowed += shadowed;
 }
 
 bool ObjectShadows::update() {

@@ -14,10 +14,6 @@ namespace lumar {
 
 namespace {
 
-// How far (metres) an object may move between updates for its lines to walk from the
-// last update's blockers: a few of the figurine's ~1 cm triangles.
-constexpr double kWalkReach = 0.03;
-
 // CPU time of the calling thread: the breakdown stays meaningful on a loaded machine.
 double thread_ms() {
   timespec t{};
@@ -245,7 +241,7 @@ void LineShadows::trace(Object& o) {
     const glm::dvec4 x(glm::dvec3(c), 1.0);
     moved = std::max(moved, glm::length(glm::dvec3(o.T_world_model * x - o.T_blocked * x)));
   }
-  if (moved > kWalkReach) o.blocked.clear();
+  if (moved > OccluderMesh::kWalkReach) o.blocked.clear();
   o.T_blocked = o.T_world_model;
   auto last = o.blocked.begin();  // both lists ascend by line: a merge
   constexpr std::ptrdiff_t kAhead = 8;  // blockers prefetched this many entries ahead

@@ -223,5 +223,34 @@ TEST(ObjectShadows, ObjectsShadowEachOther) {
   }
 }
 
+// 5. The occluder gliding a few millimetres per update: most blocked lines are proven by
+// walks from the last update's blockers, and every result equals a fresh computation at
+// the same poses (which has no blockers to walk from); a jump turns the walks off.
+TEST(ObjectShadows, SlowMotionWalksFromLastBlockers) {
+  const Mesh ball = test::make_sphere(glm::vec3(0.0f), 1.0f, 24, 12);
+  const glm::dmat4 T_a = glm::scale(translation(0, 0.1, 0), glm::dvec3(0.1));
+  const Emitters emitters = suns({{1, 0.15f, 0}, {-1, 0.25f, 0.05f}, {0.2f, 1, 0.1f}, {0.6f, 0.5f, -0.4f}});
+  const auto pose_b = [](double x) {
+    return glm::rotate(translation(x, 0.14, 0.02), 3.0 * x, glm::dvec3(0.2, 1, 0)) * glm::scale(glm::dmat4(1.0), glm::dvec3(0.12));
+  };
+  ObjectShadows moving(emitters);
+  const int a = moving.add_object(ball, T_a), b = moving.add_object(ball, pose_b(0.3));
+  for (int k = 0; k <= 6; ++k) {
+    const double x = k < 6 ? 0.3 + 0.004 * k : 0.45;  // the last: a 13 cm jump
+    moving.set_object_pose(b, pose_b(x));
+    moving.update();
+    ObjectShadows fresh(emitters);
+    fresh.add_object(ball, T_a), fresh.add_object(ball, pose_b(x));
+    fresh.update();
+    for (const int id : {a, b}) EXPECT_EQ(moving.vertex_attenuation(id), fresh.vertex_attenuation(id)) << "update " << k;
+    const ObjectShadowStats& st = moving.stats();
+    EXPECT_EQ(st.lines_blocked, fresh.stats().lines_blocked);
+    std::printf("update %d: %zu lines blocked, %zu proven by walks\n", k, st.lines_blocked, st.lines_walked);
+    EXPECT_GT(st.lines_blocked, 50u);
+    if (k == 0 || k == 6) EXPECT_EQ(st.lines_walked, 0u);
+    else EXPECT_GT(double(st.lines_walked), 0.5 * double(st.lines_blocked)) << "update " << k;
+  }
+}
+
 }  // namespace
 }  // namespace lumar

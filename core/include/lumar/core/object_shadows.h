@@ -38,8 +38,9 @@ class OccluderMesh;
 struct ObjectShadowStats {
   bool recomputed = false;
   std::size_t lines_tested = 0;       // (vertex, sample, occluder) tested against a cone
-  std::size_t rays_traced = 0;        // candidate lines traced against a mesh
+  std::size_t rays_traced = 0;        // candidate lines tested against a mesh (walked or traced)
   std::size_t lines_blocked = 0;      // (vertex, sample) lines blocked by at least one object
+  std::size_t lines_walked = 0;       // blocked lines proven by a walk from the last update's blocker (no ray)
   std::size_t vertices_shadowed = 0;  // vertices (all objects) with attenuation below 1
   double ms = 0;                      // wall time of the update
 };
@@ -88,6 +89,16 @@ class ObjectShadows {
     std::vector<Chunk> chunks, groups;
     glm::vec3 lo{0.0f}, hi{0.0f};
     std::vector<glm::vec3> attenuation;  // model vertex order
+    // Per group: the lines other objects blocked at the last update, in the order shade()
+    // visits them (sample, occluder, vertex), each with a triangle that blocked it; a
+    // line's first test this update is a walk from it (OccluderMesh::blocked_near).
+    struct Blocked {
+      std::uint32_t sample, occluder, vertex, triangle;
+    };
+    std::vector<std::vector<Blocked>> blocked;
+    // Per other object: its model space from this one's at that update (the walks pay
+    // only if the lines moved little across the occluder's mesh since).
+    std::vector<glm::dmat4> occluder_from_model;
   };
   void place(Object& o, const glm::dmat4& T_world_model);
   void shade(Object& a, std::size_t self);

@@ -39,6 +39,10 @@ class OccluderMesh {
   // triangle by a margin, so every line it proves blocked, Embree finds blocked too;
   // false means "not proven", and Embree decides.
   bool blocked_near(const glm::vec3& origin, const glm::vec3& dir, float t_far, std::uint32_t& triangle) const;
+  // How far (metres) lines may have moved across the mesh since their blockers were found
+  // for a walk from them to pay: a few of the figurine's ~1 cm triangles. Beyond, callers
+  // drop the blockers (every walk would fail, only adding to Embree's cost).
+  static constexpr double kWalkReach = 0.03;
   // Starts loading a triangle that blocked_near will soon start from (a hint).
   void prefetch(std::uint32_t triangle) const {
     if (triangle < triangles_.size()) __builtin_prefetch(&triangles_[triangle]);
