@@ -9,6 +9,7 @@
 #include <opencv2/core.hpp>
 #include <string>
 
+#include "cpu_clones.h"
 #include "lumar/core/error.h"
 
 namespace lumar {
@@ -220,7 +221,7 @@ bool OccluderMesh::occluded(const glm::vec3& origin, const glm::vec3& dir, float
   return r.tfar < 0.0f;
 }
 
-bool OccluderMesh::blocked_near(const glm::vec3& o, const glm::vec3& d, float t_far, std::uint32_t& triangle) const {
+LUMAR_AVX2_CLONES bool OccluderMesh::blocked_near(const glm::vec3& o, const glm::vec3& d, float t_far, std::uint32_t& triangle) const {
   // Margins (barycentric, and along the segment) far above float error: a hit here is a
   // hit for Embree's watertight test too. Rays within ~0.06 degrees of a triangle's plane
   // are left to Embree.

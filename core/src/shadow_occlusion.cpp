@@ -6,6 +6,7 @@
 #include <cstring>
 #include <ctime>
 
+#include "cpu_clones.h"
 #include "lumar/core/error.h"
 #include "lumar/core/occluder_mesh.h"
 #include "lumar/core/shadow_cone.h"
@@ -117,7 +118,7 @@ struct Footprint {
 // The buckets of a footprint, row by row: f(j, i0, i1) for the buckets i0..i1 of row j
 // that it may touch. Returns the number of rows scanned.
 template <class F>
-std::size_t scan_footprint(const Footprint& fp, const ReceiverGrid& g, F&& f) {
+[[gnu::always_inline]] inline std::size_t scan_footprint(const Footprint& fp, const ReceiverGrid& g, F&& f) {
   // Over a row's band of v, a half-plane bounds u on one side by a linear function of
   // the row index j: u <= or >= alpha + beta j. Precomputed, a row costs two operations
   // per plane.
@@ -169,7 +170,7 @@ std::uint32_t ones(std::uint64_t x) {
 // once, four lanes at a time.
 using Float4 = float __attribute__((vector_size(16)));
 using Int4 = std::int32_t __attribute__((vector_size(16)));
-unsigned inside4(const Footprint& fp, const float* us, const float* vs) {
+[[gnu::always_inline]] inline unsigned inside4(const Footprint& fp, const float* us, const float* vs) {
   Float4 u, v;
   std::memcpy(&u, us, sizeof u), std::memcpy(&v, vs, sizeof v);
   Int4 in = {-1, -1, -1, -1};
@@ -181,7 +182,7 @@ unsigned inside4(const Footprint& fp, const float* us, const float* vs) {
 
 // The candidates among one sample's lines for one object: the receivers in the
 // footprints of the pieces' cones that lie inside a cone, and that have a line to it.
-void LineShadows::cull(const Object& o, std::uint32_t sample) {
+LUMAR_AVX2_CLONES void LineShadows::cull(const Object& o, std::uint32_t sample) {
   const glm::vec3& e = lines_.samples[sample].position;
   const ReceiverGrids& grids = lines_.grids;
   std::size_t rows = 0, tested = 0;  // locals: the loop below stays in registers

@@ -35,6 +35,7 @@ class ShadowCone {
   static constexpr float kMargin = 1e-4f;
 
  private:
+  void build(const std::array<glm::vec3, 8>& corners, const glm::vec3& emitter, bool distant);
   std::array<glm::vec4, kMaxPlanes> planes_;
   int count_ = 0;
 };
