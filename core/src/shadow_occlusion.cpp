@@ -228,10 +228,10 @@ LUMAR_AVX2_CLONES void LineShadows::cull(const Object& o, std::uint32_t sample) 
 }
 
 // Candidates tested in model space. A line blocked at the last update walks from the
-// triangle that blocked it (while the object moves a few millimetres a frame, 85 % of
-// the blocked lines are proven so, at ~1/2 the cost of a blocked Embree ray); the others
-// are traced one ray at a time: on the figurine, Embree's single-ray traversal took ~125 ns
-// per candidate, and packets and streams were slower (docs/shadows.md lists what was tried).
+// triangle that blocked it (while the figurine moves a few millimetres a frame, 84 % of
+// the blocked lines are proven so, each at about a third of a blocked Embree ray's cost);
+// the others are traced one ray at a time: Embree's single-ray traversal beat its packets
+// and streams on these candidates (docs/shadows.md lists what was tried).
 void LineShadows::trace(Object& o) {
   const float t_far = shadow_ray_t_far(lines_.distant);
   o.next_blocked.clear();
