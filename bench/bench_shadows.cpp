@@ -97,7 +97,7 @@ void run_frames(benchmark::State& state, Built& b, bool cull, int stride) {
     b.shadows->update();
     const ShadowFrameStats& st = b.shadows->stats();
     candidates += st.rays_traced, tested += st.receivers_tested, blocked += st.lines_blocked;
-    walked += st.blocked_near, rows += st.rows_scanned;
+    walked += st.lines_walked, rows += st.rows_scanned;
     cull_ms += st.cull_ms, trace_ms += st.trace_ms;
   }
   const double n = double(state.iterations());

@@ -220,16 +220,15 @@ void ObjectShadows::shade(Object& a, std::size_t self) {
   a.blocked.resize(a.groups.size());
   a.occluder_from_model.resize(objects_.size(), glm::dmat4(0.0));
   std::vector<std::uint8_t> walk(objects_.size(), 0);
+  std::array<glm::vec3, 8> model_box;  // a's box in its model space
+  for (std::size_t k = 0; k < 8; ++k)
+    model_box[k] = glm::vec3(glm::inverse(a.T_world_model) * glm::dvec4(glm::dvec3(a.box[k]), 1.0));
   for (std::size_t bi = 0; bi < objects_.size(); ++bi) {
-    const glm::dmat4 now = glm::inverse(objects_[bi].T_world_model) * a.T_world_model;
-    double moved = 0.0;
-    for (const glm::vec3& c : a.box) {  // in world units: the occluder's may differ
-      const glm::dvec4 x = glm::inverse(a.T_world_model) * glm::dvec4(glm::dvec3(c), 1.0);
-      const glm::dvec4 then = objects_[bi].T_world_model * (a.occluder_from_model[bi] * x);
-      moved = std::max(moved, glm::length(glm::dvec3(c) - glm::dvec3(then)));
-    }
-    walk[bi] = moved <= OccluderMesh::kWalkReach;
-    a.occluder_from_model[bi] = now;
+    const glm::dmat4& T_b = objects_[bi].T_world_model;
+    // Measured in the world (the occluder's units may differ): where a's box is now, and
+    // where it would be had it kept its place on the occluder since the last update.
+    walk[bi] = OccluderMesh::within_walk_reach(model_box, a.T_world_model, T_b * a.occluder_from_model[bi]);
+    a.occluder_from_model[bi] = glm::inverse(T_b) * a.T_world_model;
   }
   std::atomic<std::size_t> tested{0}, traced{0}, blocked_lines{0}, walked{0}, shadowed{0};
   tbb::parallel_for(

@@ -204,6 +204,16 @@ OccluderMesh::OccluderMesh(const Mesh& model) {
   }
 }
 
+bool OccluderMesh::within_walk_reach(const std::array<glm::vec3, 8>& box, const glm::dmat4& world_now,
+                                     const glm::dmat4& world_then) {
+  double moved = 0.0;
+  for (const glm::vec3& c : box) {
+    const glm::dvec4 x(glm::dvec3(c), 1.0);
+    moved = std::max(moved, glm::length(glm::dvec3(world_now * x - world_then * x)));
+  }
+  return moved <= kWalkReach;
+}
+
 OccluderMesh::~OccluderMesh() { rtcReleaseScene(static_cast<RTCScene>(scene_)); }
 
 bool OccluderMesh::occluded(const glm::vec3& origin, const glm::vec3& dir, float t_far, std::uint32_t* blocker) const {

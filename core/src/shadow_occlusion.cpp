@@ -235,14 +235,8 @@ LUMAR_AVX2_CLONES void LineShadows::cull(const Object& o, std::uint32_t sample) 
 void LineShadows::trace(Object& o) {
   const float t_far = shadow_ray_t_far(lines_.distant);
   o.next_blocked.clear();
-  // A walk pays when the line's crossing moved a few triangles since the last update;
-  // after a jump it would fail at every line and only add to Embree's cost.
-  double moved = 0.0;
-  for (const glm::vec3& c : o.mesh->whole()) {
-    const glm::dvec4 x(glm::dvec3(c), 1.0);
-    moved = std::max(moved, glm::length(glm::dvec3(o.T_world_model * x - o.T_blocked * x)));
-  }
-  if (moved > OccluderMesh::kWalkReach) o.blocked.clear();
+  // After a jump, a walk would fail at every line and only add to Embree's cost.
+  if (!OccluderMesh::within_walk_reach(o.mesh->whole(), o.T_world_model, o.T_blocked)) o.blocked.clear();
   o.T_blocked = o.T_world_model;
   auto last = o.blocked.begin();  // both lists ascend by line: a merge
   constexpr std::ptrdiff_t kAhead = 8;  // blockers prefetched this many entries ahead
@@ -263,7 +257,7 @@ void LineShadows::trace(Object& o) {
     }
   }
   o.blocked.swap(o.next_blocked);
-  stats_.blocked_near += near;
+  stats_.lines_walked += near;
 }
 
 // The baseline: every line (not yet blocked by another object) against the mesh, as

@@ -43,6 +43,11 @@ class OccluderMesh {
   // for a walk from them to pay: a few of the figurine's ~1 cm triangles. Beyond, callers
   // drop the blockers (every walk would fail, only adding to Embree's cost).
   static constexpr double kWalkReach = 0.03;
+  // Whether a box (corners in some model space) moved at most kWalkReach in the world
+  // between the two maps of that space to the world: then walks from blockers found
+  // `then` pay `now`.
+  static bool within_walk_reach(const std::array<glm::vec3, 8>& box, const glm::dmat4& world_now,
+                                const glm::dmat4& world_then);
   // Starts loading a triangle that blocked_near will soon start from (a hint).
   void prefetch(std::uint32_t triangle) const {
     if (triangle < triangles_.size()) __builtin_prefetch(&triangles_[triangle]);

@@ -32,7 +32,7 @@ struct ShadowFrameStats {
   std::size_t receivers_tested = 0;  // receivers in a footprint, tested against the cone
   std::size_t rays_traced = 0;   // candidate lines traced (culling off: every line)
   std::size_t lines_blocked = 0;
-  std::size_t blocked_near = 0;  // blocked lines proven by last frame's blocker's neighbourhood, without Embree
+  std::size_t lines_walked = 0;  // blocked lines proven by a walk from last frame's blocker, without Embree
   double cull_ms = 0, trace_ms = 0;  // CPU time (calling thread) of the culling and of the ray tracing
 };
 
