@@ -12,7 +12,7 @@
 #include "lumar/calib/checkerboard_calibration.h"
 #include "lumar/calib/video_views.h"
 #include "lumar/capture/source_spec.h"
-#include "lumar/core/error.h"
+#include "lumar/base/error.h"
 
 namespace lumar::app {
 

@@ -9,7 +9,7 @@
 #include "commands.h"
 #include "lumar/calib/camera_file.h"
 #include "lumar/calib/rig_recording.h"
-#include "lumar/core/error.h"
+#include "lumar/base/error.h"
 
 namespace lumar::app {
 

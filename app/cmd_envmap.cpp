@@ -5,13 +5,13 @@
 #include <memory>
 
 #include "commands.h"
-#include "envmap_images.h"
-#include "envmap_live.h"
-#include "envmap_sweep.h"
+#include "lumar/pipeline/envmap_images.h"
+#include "lumar/pipeline/envmap_live.h"
+#include "lumar/pipeline/envmap_sweep.h"
 #include "lumar/calib/camera_file.h"
 #include "lumar/calib/camera_response.h"
 #include "lumar/capture/recording_replay.h"
-#include "lumar/core/error.h"
+#include "lumar/base/error.h"
 
 namespace lumar::app {
 

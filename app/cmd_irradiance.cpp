@@ -9,9 +9,9 @@
 #include <sstream>
 
 #include "commands.h"
-#include "lumar/core/error.h"
-#include "lumar/core/irradiance_reference.h"
-#include "lumar/core/irradiance_scene.h"
+#include "lumar/base/error.h"
+#include "lumar/lighting/irradiance_reference.h"
+#include "lumar/lighting/irradiance_scene.h"
 
 namespace lumar::app {
 

@@ -4,10 +4,10 @@
 #include <spdlog/spdlog.h>
 
 #include "commands.h"
-#include "lumar/core/error.h"
-#include "output_files.h"
-#include "live_overlay.h"
-#include "replay_overlay.h"
+#include "lumar/base/error.h"
+#include "lumar/pipeline/output_files.h"
+#include "lumar/pipeline/live_overlay.h"
+#include "lumar/pipeline/replay_overlay.h"
 
 namespace lumar::app {
 

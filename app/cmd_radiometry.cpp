@@ -14,7 +14,7 @@
 #include "lumar/calib/vignetting.h"
 #include "lumar/capture/durable_file.h"
 #include "lumar/capture/session.h"
-#include "lumar/core/error.h"
+#include "lumar/base/error.h"
 
 namespace lumar::app {
 

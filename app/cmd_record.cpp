@@ -14,11 +14,11 @@
 #include <optional>
 
 #include "commands.h"
-#include "live_inputs.h"
+#include "lumar/pipeline/live_inputs.h"
 #include "lumar/capture/capture_thread.h"
 #include "lumar/capture/recording_writer.h"
-#include "lumar/core/error.h"
-#include "stop_signal.h"
+#include "lumar/base/error.h"
+#include "lumar/pipeline/stop_signal.h"
 
 namespace lumar::app {
 

@@ -10,8 +10,8 @@
 #include <spdlog/spdlog.h>
 
 #include "commands.h"
-#include "lumar/core/error.h"
-#include "replay_overlay.h"
+#include "lumar/base/error.h"
+#include "lumar/pipeline/replay_overlay.h"
 
 namespace lumar::app {
 

@@ -7,9 +7,9 @@
 #include <sstream>
 
 #include "commands.h"
-#include "lumar/core/error.h"
-#include "lumar/core/scene.h"
-#include "lumar/core/shadow_methods.h"
+#include "lumar/base/error.h"
+#include "lumar/scene/scene.h"
+#include "lumar/lighting/shadows/shadow_methods.h"
 
 namespace lumar::app {
 

@@ -4,10 +4,10 @@
 
 #include "commands.h"
 #include "lumar/calib/camera_file.h"
-#include "lumar/core/error.h"
-#include "synthetic_board.h"
-#include "synthetic_recording.h"
-#include "synthetic_sweep.h"
+#include "lumar/base/error.h"
+#include "lumar/sim/synthetic_board.h"
+#include "lumar/sim/synthetic_recording.h"
+#include "lumar/sim/synthetic_sweep.h"
 
 namespace lumar::app {
 

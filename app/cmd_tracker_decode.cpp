@@ -11,7 +11,7 @@
 
 #include "commands.h"
 #include "lumar/capture/recording_format.h"
-#include "lumar/core/error.h"
+#include "lumar/base/error.h"
 #include "lumar/tracking/tracker_decode.h"
 // parse_tracker_chunks is private to capture/ (capture/src); the decoder needs exactly
 // that reader, so it is included from there rather than copied.

@@ -12,10 +12,10 @@
 #include <thread>
 
 #include "commands.h"
-#include "lumar/core/error.h"
+#include "lumar/base/error.h"
 #include "lumar/tracking/tracker_decode.h"
 #include "lumar/tracking/tracker_emulator.h"
-#include "stop_signal.h"
+#include "lumar/pipeline/stop_signal.h"
 
 namespace lumar::app {
 

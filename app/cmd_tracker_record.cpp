@@ -12,9 +12,9 @@
 
 #include "commands.h"
 #include "lumar/capture/recording_writer.h"
-#include "lumar/core/error.h"
+#include "lumar/base/error.h"
 #include "lumar/tracking/tracker_driver.h"
-#include "stop_signal.h"
+#include "lumar/pipeline/stop_signal.h"
 
 namespace lumar::app {
 

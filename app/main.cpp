@@ -6,7 +6,7 @@
 #include <spdlog/spdlog.h>
 
 #include "commands.h"
-#include "lumar/core/error.h"
+#include "lumar/base/error.h"
 
 #if defined(__SANITIZE_THREAD__)
 #include <tbb/global_control.h>

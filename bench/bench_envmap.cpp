@@ -12,12 +12,12 @@
 
 #include "bench_report.h"
 #include "lumar/calib/camera_file.h"
-#include "lumar/calib/envmap_quality.h"
-#include "lumar/calib/envmap_stitcher.h"
-#include "lumar/calib/envmap_view.h"
-#include "lumar/calib/hole_filling.h"
-#include "lumar/calib/orientation_refinement.h"
-#include "lumar/calib/sweep_path.h"
+#include "lumar/envmap/envmap_quality.h"
+#include "lumar/envmap/envmap_stitcher.h"
+#include "lumar/sim/envmap_view.h"
+#include "lumar/envmap/hole_filling.h"
+#include "lumar/envmap/orientation_refinement.h"
+#include "lumar/envmap/sweep_path.h"
 
 using namespace lumar;
 

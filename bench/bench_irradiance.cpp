@@ -13,10 +13,10 @@
 
 #include "bench_report.h"
 #include "test_geometry.h"
-#include "lumar/core/irradiance_reference.h"
-#include "lumar/core/irradiance_scene.h"
-#include "lumar/core/irradiance_volume.h"
-#include "lumar/core/latlong.h"
+#include "lumar/lighting/irradiance_reference.h"
+#include "lumar/lighting/irradiance_scene.h"
+#include "lumar/lighting/irradiance_volume.h"
+#include "lumar/base/latlong.h"
 
 using namespace lumar;
 

@@ -5,8 +5,8 @@
 #include "bench_report.h"
 #include "lumar/calib/undistortion.h"
 #include "lumar/capture/recording_replay.h"
-#include "lumar/core/compositor.h"
-#include "lumar/core/gl/context.h"
+#include "lumar/render/compositor.h"
+#include "lumar/render/platform/context.h"
 
 using namespace lumar;
 

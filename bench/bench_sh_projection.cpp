@@ -9,9 +9,9 @@
 #include <random>
 
 #include "bench_report.h"
-#include "lumar/core/envmap.h"
-#include "lumar/core/latlong.h"
-#include "lumar/core/sh.h"
+#include "lumar/scene/envmap.h"
+#include "lumar/base/latlong.h"
+#include "lumar/lighting/sh.h"
 
 using namespace lumar;
 

@@ -17,12 +17,12 @@
 #include <memory>
 
 #include "bench_report.h"
-#include "lumar/core/scene.h"
-#include "lumar/core/shadow_methods.h"
-#include "lumar/core/ray_scene.h"
-#include "lumar/core/object_shadows.h"
-#include "lumar/core/occluder_mesh.h"
-#include "lumar/core/shadow_occlusion.h"
+#include "lumar/scene/scene.h"
+#include "lumar/lighting/shadows/shadow_methods.h"
+#include "lumar/lighting/ray_scene.h"
+#include "lumar/lighting/shadows/object_shadows.h"
+#include "lumar/lighting/shadows/occluder_mesh.h"
+#include "lumar/lighting/shadows/shadow_occlusion.h"
 
 using namespace lumar;
 

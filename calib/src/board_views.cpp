@@ -2,7 +2,7 @@
 
 #include <opencv2/imgcodecs.hpp>
 
-#include "lumar/core/error.h"
+#include "lumar/base/error.h"
 
 namespace lumar::calib {
 

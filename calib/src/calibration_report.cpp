@@ -6,7 +6,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include "lumar/core/error.h"
+#include "lumar/base/error.h"
 
 namespace lumar::calib {
 

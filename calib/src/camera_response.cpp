@@ -7,8 +7,8 @@
 #include <opencv2/photo.hpp>
 #include <string>
 
-#include "lumar/core/color.h"
-#include "lumar/core/error.h"
+#include "lumar/base/color.h"
+#include "lumar/base/error.h"
 
 namespace lumar::calib {
 namespace {

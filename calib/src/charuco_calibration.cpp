@@ -3,7 +3,7 @@
 #include <opencv2/aruco/charuco.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include "lumar/core/error.h"
+#include "lumar/base/error.h"
 
 namespace lumar::calib {
 

@@ -6,7 +6,7 @@
 #include <opencv2/calib3d.hpp>
 
 #include "lumar/calib/board_pose.h"
-#include "lumar/core/error.h"
+#include "lumar/base/error.h"
 
 namespace lumar::calib {
 

@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "lumar/core/error.h"
+#include "lumar/base/error.h"
 
 namespace lumar::calib {
 

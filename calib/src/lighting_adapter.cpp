@@ -4,7 +4,7 @@
 #include <cmath>
 #include <vector>
 
-#include "lumar/core/error.h"
+#include "lumar/base/error.h"
 
 namespace lumar::calib {
 

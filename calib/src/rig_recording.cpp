@@ -6,7 +6,7 @@
 #include "lumar/capture/durable_file.h"
 #include "lumar/capture/recording_format.h"
 #include "lumar/capture/recording_reader.h"
-#include "lumar/core/error.h"
+#include "lumar/base/error.h"
 #include "lumar/tracking/pose_conversion.h"
 #include "lumar/tracking/record_codec.h"
 #include "lumar/tracking/record_parser.h"

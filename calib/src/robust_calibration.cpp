@@ -7,7 +7,7 @@
 #include <opencv2/calib3d.hpp>
 #include <random>
 
-#include "lumar/core/error.h"
+#include "lumar/base/error.h"
 
 namespace lumar::calib {
 

@@ -1,6 +1,6 @@
 #include "lumar/calib/video_views.h"
 
-#include "lumar/core/error.h"
+#include "lumar/base/error.h"
 
 namespace lumar::calib {
 

@@ -5,7 +5,7 @@
 #include <opencv2/imgproc.hpp>
 #include <string>
 
-#include "lumar/core/error.h"
+#include "lumar/base/error.h"
 
 namespace lumar::calib {
 namespace {

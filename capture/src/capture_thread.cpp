@@ -4,7 +4,7 @@
 #include <cmath>
 
 #include "lumar/capture/v4l2_source.h"
-#include "lumar/core/error.h"
+#include "lumar/base/error.h"
 
 namespace lumar::capture {
 

@@ -6,7 +6,7 @@
 #include <limits>
 #include <sstream>
 
-#include "lumar/core/error.h"
+#include "lumar/base/error.h"
 
 namespace lumar::capture::csv {
 

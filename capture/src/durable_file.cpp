@@ -7,7 +7,7 @@
 #include <cstring>
 #include <utility>
 
-#include "lumar/core/error.h"
+#include "lumar/base/error.h"
 
 namespace lumar::capture {
 namespace {

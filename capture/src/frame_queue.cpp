@@ -2,7 +2,7 @@
 
 #include <chrono>
 
-#include "lumar/core/error.h"
+#include "lumar/base/error.h"
 
 namespace lumar::capture {
 

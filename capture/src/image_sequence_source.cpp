@@ -10,7 +10,7 @@
 #include <set>
 
 #include "csv_text.h"
-#include "lumar/core/error.h"
+#include "lumar/base/error.h"
 
 namespace lumar::capture {
 namespace fs = std::filesystem;

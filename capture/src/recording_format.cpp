@@ -3,7 +3,7 @@
 #include <cmath>
 #include <cstdio>
 
-#include "lumar/core/error.h"
+#include "lumar/base/error.h"
 
 namespace lumar::capture {
 namespace {

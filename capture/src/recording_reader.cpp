@@ -4,7 +4,7 @@
 
 #include "csv_text.h"
 #include "lumar/capture/recording_source.h"
-#include "lumar/core/error.h"
+#include "lumar/base/error.h"
 #include "lumar/capture/tracker_raw.h"
 
 namespace lumar::capture {

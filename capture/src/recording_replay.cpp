@@ -1,6 +1,6 @@
 #include "lumar/capture/recording_replay.h"
 
-#include "lumar/core/error.h"
+#include "lumar/base/error.h"
 #include "lumar/tracking/record_parser.h"
 #include "lumar/tracking/pose_conversion.h"
 #include "lumar/tracking/timestamping.h"

@@ -1,7 +1,7 @@
 #include "lumar/capture/recording_source.h"
 
 #include "lumar/capture/recording_reader.h"
-#include "lumar/core/error.h"
+#include "lumar/base/error.h"
 
 namespace lumar::capture {
 

@@ -15,7 +15,7 @@
 
 #include "csv_text.h"
 #include "lumar/capture/durable_file.h"
-#include "lumar/core/error.h"
+#include "lumar/base/error.h"
 #include "lumar/capture/tracker_raw.h"
 
 namespace lumar::capture {

@@ -2,7 +2,7 @@
 
 #include <cmath>
 
-#include "lumar/core/error.h"
+#include "lumar/base/error.h"
 
 namespace lumar::capture {
 

@@ -6,7 +6,7 @@
 #include <limits>
 
 #include "lumar/capture/recording_format.h"
-#include "lumar/core/error.h"
+#include "lumar/base/error.h"
 
 namespace lumar::capture {
 namespace {

@@ -4,7 +4,7 @@
 #include <cmath>
 #include <opencv2/imgproc.hpp>
 
-#include "lumar/core/error.h"
+#include "lumar/base/error.h"
 
 namespace lumar::capture {
 

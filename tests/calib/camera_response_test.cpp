@@ -11,9 +11,9 @@
 #include <nlohmann/json.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include "lumar/core/color.h"
-#include "lumar/core/envmap.h"
-#include "lumar/core/error.h"
+#include "lumar/base/color.h"
+#include "lumar/scene/envmap.h"
+#include "lumar/base/error.h"
 #include "test_paths.h"
 
 namespace lumar::calib {

@@ -11,7 +11,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include "lumar/core/error.h"
+#include "lumar/base/error.h"
 #include "test_paths.h"
 
 namespace lumar::calib {

@@ -14,7 +14,7 @@
 
 #include "lumar/calib/calibration_report.h"
 #include "lumar/calib/checkerboard_calibration.h"
-#include "lumar/core/error.h"
+#include "lumar/base/error.h"
 #include "test_paths.h"
 
 namespace lumar::calib {

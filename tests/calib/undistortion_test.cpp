@@ -9,7 +9,7 @@
 #include <opencv2/calib3d.hpp>
 
 #include "lumar/calib/camera_file.h"
-#include "lumar/core/error.h"
+#include "lumar/base/error.h"
 #include "test_paths.h"
 
 namespace lumar::calib {

@@ -9,8 +9,8 @@
 #include <opencv2/imgproc.hpp>
 
 #include "lumar/calib/camera_response.h"
-#include "lumar/core/color.h"
-#include "lumar/core/error.h"
+#include "lumar/base/color.h"
+#include "lumar/base/error.h"
 
 namespace lumar::calib {
 namespace {

@@ -9,8 +9,8 @@
 #include <random>
 #include <string>
 
-#include "lumar/core/error.h"
-#include "lumar/core/pose.h"
+#include "lumar/base/error.h"
+#include "lumar/base/pose.h"
 #include "lumar/tracking/byte_chunk.h"
 #include "lumar/tracking/pose_sample.h"
 

@@ -18,7 +18,7 @@
 #include <vector>
 
 #include "lumar/capture/v4l2_device.h"
-#include "lumar/core/time.h"
+#include "lumar/base/time.h"
 
 namespace lumar::test {
 

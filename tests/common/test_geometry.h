@@ -3,7 +3,7 @@
 #include <glm/glm.hpp>
 #include <vector>
 
-#include "lumar/core/mesh.h"
+#include "lumar/scene/mesh.h"
 
 namespace lumar::test {
 

@@ -5,16 +5,16 @@
 #include <algorithm>
 #include <cmath>
 
-#include "lumar/core/color.h"
-#include "lumar/core/error.h"
+#include "lumar/base/color.h"
+#include "lumar/base/error.h"
 
-#include "lumar/calib/envmap_quality.h"
-#include "lumar/calib/envmap_stitcher.h"
-#include "lumar/calib/hole_filling.h"
-#include "lumar/calib/orientation_refinement.h"
-#include "lumar/calib/sweep_path.h"
-#include "lumar/core/latlong.h"
-#include "lumar/core/sh.h"
+#include "lumar/envmap/envmap_quality.h"
+#include "lumar/envmap/envmap_stitcher.h"
+#include "lumar/envmap/hole_filling.h"
+#include "lumar/envmap/orientation_refinement.h"
+#include "lumar/envmap/sweep_path.h"
+#include "lumar/base/latlong.h"
+#include "lumar/lighting/sh.h"
 #include "sweep_fixture.h"
 #include "test_paths.h"
 

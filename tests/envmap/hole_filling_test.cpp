@@ -3,10 +3,10 @@
 
 #include <cmath>
 
-#include "lumar/core/error.h"
+#include "lumar/base/error.h"
 
-#include "lumar/calib/hole_filling.h"
-#include "lumar/core/latlong.h"
+#include "lumar/envmap/hole_filling.h"
+#include "lumar/base/latlong.h"
 
 namespace lumar {
 namespace {

@@ -3,9 +3,9 @@
 
 #include <cmath>
 
-#include "lumar/core/error.h"
+#include "lumar/base/error.h"
 
-#include "lumar/calib/orientation_refinement.h"
+#include "lumar/envmap/orientation_refinement.h"
 #include "sweep_fixture.h"
 
 namespace lumar {

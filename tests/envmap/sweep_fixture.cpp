@@ -6,8 +6,8 @@
 #include <random>
 
 #include "lumar/calib/camera_file.h"
-#include "lumar/calib/orientation_refinement.h"
-#include "lumar/calib/sweep_path.h"
+#include "lumar/envmap/orientation_refinement.h"
+#include "lumar/envmap/sweep_path.h"
 #include "test_paths.h"
 
 namespace lumar::test {

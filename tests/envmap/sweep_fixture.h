@@ -8,10 +8,10 @@
 #include <string>
 #include <vector>
 
-#include "lumar/calib/envmap_view.h"
-#include "lumar/calib/orientation_refinement.h"
-#include "lumar/core/camera.h"
-#include "lumar/core/envmap.h"
+#include "lumar/sim/envmap_view.h"
+#include "lumar/envmap/orientation_refinement.h"
+#include "lumar/base/camera.h"
+#include "lumar/scene/envmap.h"
 
 namespace lumar::test {
 

@@ -5,7 +5,7 @@
 
 #include <cstdlib>
 
-#include "lumar/core/gl/context.h"
+#include "lumar/render/platform/context.h"
 
 namespace {
 

@@ -4,7 +4,7 @@
 
 #include <opencv2/core.hpp>
 
-#include "lumar/core/gl/renderer.h"
+#include "lumar/render/renderer.h"
 #include "render_test_util.h"
 
 using namespace lumar;

@@ -7,7 +7,7 @@
 #include <numbers>
 #include <opencv2/imgproc.hpp>
 
-#include "lumar/core/gl/renderer.h"
+#include "lumar/render/renderer.h"
 #include "render_test_util.h"
 
 namespace lumar::test {

@@ -6,7 +6,7 @@
 #include <glm/gtc/matrix_transform.hpp>
 #include <opencv2/calib3d.hpp>
 
-#include "lumar/core/gl/renderer.h"
+#include "lumar/render/renderer.h"
 #include "render_test_util.h"
 
 namespace lumar::test {

@@ -3,11 +3,11 @@
 // (meshes built in code are in test_geometry.h).
 #include <opencv2/core.hpp>
 
-#include "lumar/core/camera.h"
-#include "lumar/core/gl/context.h"
-#include "lumar/core/mesh.h"
-#include "lumar/core/pose.h"
-#include "lumar/core/sh.h"
+#include "lumar/base/camera.h"
+#include "lumar/render/platform/context.h"
+#include "lumar/scene/mesh.h"
+#include "lumar/base/pose.h"
+#include "lumar/lighting/sh.h"
 #include "test_geometry.h"
 
 namespace lumar::test {

@@ -5,9 +5,9 @@
 #include <cmath>
 #include <numbers>
 
-#include "lumar/core/error.h"
-#include "lumar/core/gl/renderer.h"
-#include "lumar/core/latlong.h"
+#include "lumar/base/error.h"
+#include "lumar/render/renderer.h"
+#include "lumar/base/latlong.h"
 #include "render_test_util.h"
 
 namespace lumar::test {

@@ -5,9 +5,9 @@
 
 #include <numbers>
 
-#include "lumar/core/color.h"
-#include "lumar/core/gl/renderer.h"
-#include "lumar/core/latlong.h"
+#include "lumar/base/color.h"
+#include "lumar/render/renderer.h"
+#include "lumar/base/latlong.h"
 #include "render_test_util.h"
 
 namespace lumar::test {

@@ -5,8 +5,8 @@
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include "lumar/core/error.h"
-#include "lumar/core/gl/renderer.h"
+#include "lumar/base/error.h"
+#include "lumar/render/renderer.h"
 #include "render_test_util.h"
 
 namespace lumar::test {

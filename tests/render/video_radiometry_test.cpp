@@ -6,8 +6,8 @@
 #include <cmath>
 #include <random>
 
-#include "lumar/core/error.h"
-#include "lumar/core/gl/renderer.h"
+#include "lumar/base/error.h"
+#include "lumar/render/renderer.h"
 #include "render_test_util.h"
 
 namespace lumar::test {

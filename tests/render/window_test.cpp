@@ -2,8 +2,8 @@
 // Without a display they fail, by design: a skipped window test would hide a broken setup.
 #include <gtest/gtest.h>
 
-#include "lumar/core/gl/context.h"
-#include "lumar/core/gl/renderer.h"
+#include "lumar/render/platform/context.h"
+#include "lumar/render/renderer.h"
 #include "render_test_util.h"
 
 namespace lumar::test {

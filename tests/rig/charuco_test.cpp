@@ -14,7 +14,7 @@
 #include "lumar/calib/camera_file.h"
 #include "lumar/calib/charuco_calibration.h"
 #include "lumar/calib/robust_calibration.h"
-#include "lumar/core/error.h"
+#include "lumar/base/error.h"
 #include "test_paths.h"
 
 namespace lumar {

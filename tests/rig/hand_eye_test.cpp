@@ -10,7 +10,7 @@
 #include "lumar/calib/hand_eye_calibration.h"
 #include "lumar/calib/latency_estimation.h"
 #include "lumar/capture/recording_reader.h"
-#include "lumar/core/error.h"
+#include "lumar/base/error.h"
 
 namespace lumar {
 namespace {

@@ -8,7 +8,7 @@
 
 #include "board_recordings.h"
 #include "lumar/calib/rig_calibration.h"
-#include "lumar/core/error.h"
+#include "lumar/base/error.h"
 
 namespace lumar {
 namespace {

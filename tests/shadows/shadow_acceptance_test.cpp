@@ -6,8 +6,8 @@
 
 #include <glm/gtc/matrix_transform.hpp>
 
-#include "lumar/core/scene.h"
-#include "lumar/core/shadow_methods.h"
+#include "lumar/scene/scene.h"
+#include "lumar/lighting/shadows/shadow_methods.h"
 #include "shadow_test_util.h"
 #include "test_paths.h"
 

@@ -11,11 +11,11 @@
 #include <string>
 #include <vector>
 
-#include "lumar/core/scene.h"
-#include "lumar/core/shadow_cone.h"
-#include "lumar/core/shadow_methods.h"
-#include "lumar/core/shadow_occlusion.h"
-#include "lumar/core/shadow_receiver_grid.h"
+#include "lumar/scene/scene.h"
+#include "lumar/lighting/shadows/shadow_cone.h"
+#include "lumar/lighting/shadows/shadow_methods.h"
+#include "lumar/lighting/shadows/shadow_occlusion.h"
+#include "lumar/lighting/shadows/shadow_receiver_grid.h"
 #include "shadow_test_util.h"
 #include "sample_room_lines.h"
 #include "test_paths.h"

@@ -9,11 +9,11 @@
 #include <numbers>
 #include <random>
 
-#include "lumar/core/error.h"
-#include "lumar/core/scene.h"
-#include "lumar/core/shadow_methods.h"
-#include "lumar/core/shadow_occlusion.h"
-#include "lumar/core/shadow_receivers.h"
+#include "lumar/base/error.h"
+#include "lumar/scene/scene.h"
+#include "lumar/lighting/shadows/shadow_methods.h"
+#include "lumar/lighting/shadows/shadow_occlusion.h"
+#include "lumar/lighting/shadows/shadow_receivers.h"
 #include "shadow_test_util.h"
 #include "sample_room_lines.h"
 #include "test_paths.h"

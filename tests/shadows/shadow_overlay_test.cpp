@@ -11,11 +11,11 @@
 #include <optional>
 #include <sstream>
 
-#include "lumar/core/color.h"
-#include "lumar/core/compositor.h"
-#include "lumar/core/gl/context.h"
-#include "lumar/core/object_shadows.h"
-#include "lumar/core/shadow_occlusion.h"
+#include "lumar/base/color.h"
+#include "lumar/render/compositor.h"
+#include "lumar/render/platform/context.h"
+#include "lumar/lighting/shadows/object_shadows.h"
+#include "lumar/lighting/shadows/shadow_occlusion.h"
 #include "test_paths.h"
 
 namespace lumar {

@@ -4,7 +4,7 @@
 #include <cmath>
 #include <numbers>
 
-#include "lumar/core/latlong.h"
+#include "lumar/base/latlong.h"
 
 namespace lumar::test {
 

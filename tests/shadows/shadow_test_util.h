@@ -5,8 +5,8 @@
 #include <glm/glm.hpp>
 #include <vector>
 
-#include "lumar/core/envmap.h"
-#include "lumar/core/mesh.h"
+#include "lumar/scene/envmap.h"
+#include "lumar/scene/mesh.h"
 #include "test_geometry.h"
 
 namespace lumar::test {

@@ -6,7 +6,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "lumar/core/error.h"
+#include "lumar/base/error.h"
 #include "lumar/tracking/isotrak_ascii.h"
 #include "lumar/tracking/timestamping.h"
 

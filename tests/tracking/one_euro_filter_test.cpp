@@ -7,7 +7,7 @@
 #include <numbers>
 #include <random>
 
-#include "lumar/core/error.h"
+#include "lumar/base/error.h"
 #include "lumar/tracking/one_euro_filter.h"
 
 namespace lumar::tracking {

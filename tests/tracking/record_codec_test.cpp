@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "lumar/core/error.h"
+#include "lumar/base/error.h"
 #include "lumar/tracking/pose_conversion.h"
 #include "lumar/tracking/record_codec.h"
 #include "lumar/tracking/record_parser.h"

@@ -4,7 +4,7 @@
 
 #include <cmath>
 
-#include "lumar/core/error.h"
+#include "lumar/base/error.h"
 #include "lumar/tracking/isotrak_ascii.h"
 #include "lumar/tracking/pose_conversion.h"
 #include "lumar/tracking/pose_stream.h"

@@ -8,7 +8,7 @@
 #include <span>
 #include <thread>
 
-#include "lumar/core/pose.h"
+#include "lumar/base/pose.h"
 #include "lumar/tracking/record_codec.h"
 #include "lumar/tracking/serial_transport.h"
 #include "lumar/tracking/tracker_emulator.h"

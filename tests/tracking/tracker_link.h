@@ -12,7 +12,7 @@
 #include <thread>
 #include <vector>
 
-#include "lumar/core/pose.h"
+#include "lumar/base/pose.h"
 #include "lumar/tracking/pose_conversion.h"
 #include "lumar/tracking/tracker_driver.h"
 #include "lumar/tracking/tracker_emulator.h"

@@ -7,7 +7,7 @@
 #include <fstream>
 #include <thread>
 
-#include "lumar/core/error.h"
+#include "lumar/base/error.h"
 #include "lumar/tracking/device_enumeration.h"
 #include "lumar/tracking/measurement_model.h"
 #include "lumar/tracking/spsc_ring.h"

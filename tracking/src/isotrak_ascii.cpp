@@ -6,7 +6,7 @@
 #include <string>
 #include <utility>
 
-#include "lumar/core/error.h"
+#include "lumar/base/error.h"
 #include "record_header.h"
 
 namespace lumar::tracking {

@@ -3,7 +3,7 @@
 #include <cmath>
 #include <string>
 
-#include "lumar/core/error.h"
+#include "lumar/base/error.h"
 #include "lumar/tracking/pose_conversion.h"
 
 namespace lumar::tracking {

@@ -4,7 +4,7 @@
 #include <numbers>
 #include <string>
 
-#include "lumar/core/error.h"
+#include "lumar/base/error.h"
 
 namespace lumar::tracking {
 

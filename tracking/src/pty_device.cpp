@@ -9,7 +9,7 @@
 #include <cstdlib>
 #include <cstring>
 
-#include "lumar/core/error.h"
+#include "lumar/base/error.h"
 
 namespace lumar::tracking {
 

@@ -5,7 +5,7 @@
 
 #include "fastrak_binary.h"
 #include "isotrak_binary.h"
-#include "lumar/core/error.h"
+#include "lumar/base/error.h"
 #include "lumar/tracking/isotrak_ascii.h"
 
 namespace lumar::tracking {

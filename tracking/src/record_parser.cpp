@@ -3,7 +3,7 @@
 #include <string>
 #include <utility>
 
-#include "lumar/core/error.h"
+#include "lumar/base/error.h"
 #include "lumar/tracking/timestamping.h"
 
 namespace lumar::tracking {

@@ -3,7 +3,7 @@
 #include <cmath>
 #include <nlohmann/json.hpp>
 
-#include "lumar/core/error.h"
+#include "lumar/base/error.h"
 
 namespace lumar::tracking {
 

@@ -7,7 +7,7 @@
 #include <string_view>
 #include <thread>
 
-#include "lumar/core/error.h"
+#include "lumar/base/error.h"
 #include "lumar/tracking/pose_conversion.h"
 #include "lumar/tracking/record_parser.h"
 #include "lumar/tracking/spsc_ring.h"

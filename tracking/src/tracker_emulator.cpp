@@ -18,7 +18,7 @@
 #include <string_view>
 #include <thread>
 
-#include "lumar/core/error.h"
+#include "lumar/base/error.h"
 #include "lumar/tracking/measurement_model.h"
 #include "lumar/tracking/timestamping.h"
 #include "pty_device.h"

@@ -8,7 +8,7 @@
 #include <numbers>
 #include <sstream>
 
-#include "lumar/core/error.h"
+#include "lumar/base/error.h"
 #include "lumar/tracking/pose_stream.h"
 
 namespace lumar::tracking {

@@ -8,8 +8,8 @@
 #include <optional>
 #include <vector>
 
-#include "lumar/core/camera.h"
-#include "lumar/core/pose.h"
+#include "lumar/base/camera.h"
+#include "lumar/base/pose.h"
 
 namespace lumar::calib {
 

@@ -4,7 +4,7 @@
 // avg_reprojection_error). Extra statistics may sit beside them.
 #include <filesystem>
 
-#include "lumar/core/camera.h"
+#include "lumar/base/camera.h"
 
 namespace lumar::calib {
 

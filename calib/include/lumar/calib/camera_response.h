@@ -2,7 +2,7 @@
 // Camera response: what relative linear exposure (scene radiance x exposure time, up to
 // one scale) produced each 8-bit video value, per channel. Recovered from bracketed
 // exposures (Debevec-Malik), or the documented default: the sRGB transfer curve with a
-// gain (see lumar/core/color.h). Channels are in the images' own order (BGR for images
+// gain (see lumar/base/color.h). Channels are in the images' own order (BGR for images
 // read by OpenCV).
 #include <array>
 #include <filesystem>

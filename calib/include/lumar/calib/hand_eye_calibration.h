@@ -8,7 +8,7 @@
 // T_camera_board, cam2gripper = T_sensor_camera.
 #include <vector>
 
-#include "lumar/core/pose.h"
+#include "lumar/base/pose.h"
 
 namespace lumar::calib {
 

@@ -6,8 +6,8 @@
 // a parabola through the peak and its neighbours refines it below the search step.
 #include <vector>
 
-#include "lumar/core/pose.h"
-#include "lumar/core/time.h"
+#include "lumar/base/pose.h"
+#include "lumar/base/time.h"
 
 namespace lumar::calib {
 

@@ -9,7 +9,7 @@
 // while a real change is followed smoothly until it has been caught up.
 #include <opencv2/core.hpp>
 
-#include "lumar/core/time.h"
+#include "lumar/base/time.h"
 
 namespace lumar::calib {
 

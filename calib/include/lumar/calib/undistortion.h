@@ -1,9 +1,9 @@
 #pragma once
 // Undistortion of camera images, and its inverse (adding a lens's distortion to a
-// pinhole rendering, used by the synthetic renderer). Camera model in lumar/core/camera.h.
+// pinhole rendering, used by the synthetic renderer). Camera model in lumar/base/camera.h.
 #include <opencv2/core.hpp>
 
-#include "lumar/core/camera.h"
+#include "lumar/base/camera.h"
 
 namespace lumar::calib {
 

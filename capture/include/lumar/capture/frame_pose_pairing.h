@@ -16,7 +16,7 @@
 #include <vector>
 
 #include "lumar/capture/frame_source.h"
-#include "lumar/core/pose.h"
+#include "lumar/base/pose.h"
 #include "lumar/tracking/pose_stream.h"
 #include "lumar/tracking/rig.h"
 

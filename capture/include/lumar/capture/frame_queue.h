@@ -13,7 +13,7 @@
 #include <mutex>
 
 #include "lumar/capture/frame_source.h"
-#include "lumar/core/time.h"
+#include "lumar/base/time.h"
 
 namespace lumar::capture {
 

@@ -5,7 +5,7 @@
 #include <opencv2/core.hpp>
 #include <string>
 
-#include "lumar/core/time.h"
+#include "lumar/base/time.h"
 
 namespace lumar::capture {
 

@@ -21,8 +21,8 @@
 #include <opencv2/core.hpp>
 #include <string>
 
-#include "lumar/core/pose.h"
-#include "lumar/core/time.h"
+#include "lumar/base/pose.h"
+#include "lumar/base/time.h"
 
 namespace lumar::capture {
 

@@ -15,7 +15,7 @@
 
 #include "lumar/capture/frame_source.h"
 #include "lumar/capture/recording_format.h"
-#include "lumar/core/pose.h"
+#include "lumar/base/pose.h"
 #include "lumar/tracking/byte_chunk.h"
 #include "lumar/tracking/pose_sample.h"
 

@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "lumar/core/camera.h"
+#include "lumar/base/camera.h"
 #include "lumar/tracking/rig.h"
 
 namespace lumar::capture {

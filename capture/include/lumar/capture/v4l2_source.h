@@ -16,8 +16,8 @@
 
 #include "lumar/capture/frame_source.h"
 #include "lumar/capture/v4l2_device.h"
-#include "lumar/core/error.h"
-#include "lumar/core/time.h"
+#include "lumar/base/error.h"
+#include "lumar/base/time.h"
 
 namespace lumar::capture {
 

@@ -5,7 +5,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "lumar/core/time.h"
+#include "lumar/base/time.h"
 
 namespace lumar::tracking {
 

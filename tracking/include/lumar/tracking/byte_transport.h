@@ -5,8 +5,8 @@
 #include <string>
 #include <string_view>
 
-#include "lumar/core/error.h"
-#include "lumar/core/time.h"
+#include "lumar/base/error.h"
+#include "lumar/base/time.h"
 #include "lumar/tracking/byte_chunk.h"
 
 namespace lumar::tracking {

@@ -8,7 +8,7 @@
 #include <glm/glm.hpp>
 #include <glm/gtc/quaternion.hpp>
 
-#include "lumar/core/time.h"
+#include "lumar/base/time.h"
 
 namespace lumar::tracking {
 

@@ -6,7 +6,7 @@
 #include <cstdint>
 #include <random>
 
-#include "lumar/core/pose.h"
+#include "lumar/base/pose.h"
 #include "lumar/tracking/isotrak_record.h"
 
 namespace lumar::tracking {

@@ -18,8 +18,8 @@
 #include <map>
 #include <optional>
 
-#include "lumar/core/pose.h"
-#include "lumar/core/time.h"
+#include "lumar/base/pose.h"
+#include "lumar/base/time.h"
 #include "lumar/tracking/pose_sample.h"
 
 namespace lumar::tracking {

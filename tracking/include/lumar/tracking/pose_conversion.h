@@ -4,7 +4,7 @@
 // past this point sees device units or Euler angles.
 #include <optional>
 
-#include "lumar/core/time.h"
+#include "lumar/base/time.h"
 #include "lumar/tracking/isotrak_record.h"
 #include "lumar/tracking/pose_sample.h"
 

@@ -1,8 +1,8 @@
 #pragma once
 // One decoded tracker reading, already converted at the edge of tracking/:
 // metres and a unit quaternion, in the transmitter frame (Polhemus +Z down).
-#include "lumar/core/pose.h"
-#include "lumar/core/time.h"
+#include "lumar/base/pose.h"
+#include "lumar/base/time.h"
 
 namespace lumar::tracking {
 

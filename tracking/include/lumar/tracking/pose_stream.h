@@ -10,8 +10,8 @@
 #include <optional>
 #include <vector>
 
-#include "lumar/core/pose.h"
-#include "lumar/core/time.h"
+#include "lumar/base/pose.h"
+#include "lumar/base/time.h"
 #include "lumar/tracking/pose_sample.h"
 
 namespace lumar::tracking {

@@ -3,8 +3,8 @@
 // sits on the sensor, and how late the tracker reports.
 #include <nlohmann/json_fwd.hpp>
 
-#include "lumar/core/pose.h"
-#include "lumar/core/time.h"
+#include "lumar/base/pose.h"
+#include "lumar/base/time.h"
 
 namespace lumar::tracking {
 

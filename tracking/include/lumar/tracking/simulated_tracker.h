@@ -8,8 +8,8 @@
 #include <functional>
 #include <vector>
 
-#include "lumar/core/pose.h"
-#include "lumar/core/time.h"
+#include "lumar/base/pose.h"
+#include "lumar/base/time.h"
 #include "lumar/tracking/byte_chunk.h"
 #include "lumar/tracking/isotrak_record.h"
 #include "lumar/tracking/pose_sample.h"

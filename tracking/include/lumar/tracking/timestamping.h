@@ -14,7 +14,7 @@
 // the record length, output list or baud. Rounding is to the nearest nanosecond.
 #include <cstdint>
 
-#include "lumar/core/time.h"
+#include "lumar/base/time.h"
 
 namespace lumar::tracking {
 

@@ -24,7 +24,7 @@
 #include <string>
 #include <vector>
 
-#include "lumar/core/time.h"
+#include "lumar/base/time.h"
 #include "lumar/tracking/byte_transport.h"
 #include "lumar/tracking/pose_sample.h"
 #include "lumar/tracking/record_codec.h"

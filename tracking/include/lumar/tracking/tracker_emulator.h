@@ -32,7 +32,7 @@
 #include <string>
 #include <vector>
 
-#include "lumar/core/time.h"
+#include "lumar/base/time.h"
 #include "lumar/tracking/isotrak_record.h"
 #include "lumar/tracking/record_codec.h"
 #include "lumar/tracking/trajectory.h"

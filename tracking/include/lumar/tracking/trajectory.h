@@ -6,8 +6,8 @@
 #include <string>
 #include <vector>
 
-#include "lumar/core/pose.h"
-#include "lumar/core/time.h"
+#include "lumar/base/pose.h"
+#include "lumar/base/time.h"
 
 namespace lumar::tracking {
 

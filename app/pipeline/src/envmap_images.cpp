@@ -1,0 +1,238 @@
+#include "lumar/pipeline/envmap_images.h"
+
+#include <charconv>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <map>
+#include <opencv2/imgcodecs.hpp>
+#include <spdlog/spdlog.h>
+#include <sstream>
+
+#include "lumar/calib/camera_file.h"
+#include "lumar/calib/camera_response.h"
+#include "lumar/capture/image_sequence_source.h"
+#include "lumar/base/error.h"
+
+namespace lumar::app {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+struct PoseRow {
+  std::string file;
+  glm::dquat rotation{1, 0, 0, 0};
+  std::optional<glm::dvec3> position;
+  double exposure = 1.0;
+  std::optional<int> station;
+  int line = 0;
+};
+
+std::vector<std::string> split_fields(const std::string& line) {
+  std::vector<std::string> out;
+  std::stringstream ss(line);
+  std::string field;
+  while (std::getline(ss, field, ',')) {
+    const auto a = field.find_first_not_of(" \t"), b = field.find_last_not_of(" \t");
+    out.push_back(a == std::string::npos ? std::string() : field.substr(a, b - a + 1));
+  }
+  if (!line.empty() && line.back() == ',') out.emplace_back();
+  return out;
+}
+
+bool parse_double(const std::string& s, double& v) {
+  if (s.empty()) return false;
+  char* end = nullptr;
+  v = std::strtod(s.c_str(), &end);
+  return end == s.c_str() + s.size();
+}
+
+std::vector<PoseRow> read_poses_csv(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw InputError(path + ": cannot read the poses; check the path");
+  std::string line;
+  if (!std::getline(in, line)) throw InputError(path + ": empty; expected a header file,qw,qx,qy,qz[,x,y,z][,exposure][,station]");
+  if (!line.empty() && line.back() == '\r') line.pop_back();
+  const std::vector<std::string> header = split_fields(line);
+  std::map<std::string, int> column;
+  static const std::vector<std::string> kKnown{"file", "qw", "qx", "qy", "qz", "x", "y", "z", "exposure", "station"};
+  for (int i = 0; i < int(header.size()); ++i) {
+    if (std::find(kKnown.begin(), kKnown.end(), header[i]) == kKnown.end())
+      throw InputError(path + ":1: unknown column '" + header[i] +
+                       "'; the columns are file,qw,qx,qy,qz[,x,y,z][,exposure][,station]");
+    if (!column.emplace(header[i], i).second) throw InputError(path + ":1: column '" + header[i] + "' appears twice");
+  }
+  for (const char* required : {"file", "qw", "qx", "qy", "qz"})
+    if (!column.count(required))
+      throw InputError(path + ":1: no '" + required + "' column; the header must name file,qw,qx,qy,qz");
+  const int positions = int(column.count("x") + column.count("y") + column.count("z"));
+  if (positions != 0 && positions != 3) throw InputError(path + ":1: give all of x,y,z or none");
+
+  std::vector<PoseRow> rows;
+  std::map<std::string, int> seen;
+  int line_number = 1;
+  while (std::getline(in, line)) {
+    ++line_number;
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    if (line.empty()) continue;
+    const std::string where = path + ":" + std::to_string(line_number) + ": ";
+    const auto f = split_fields(line);
+    if (f.size() != header.size())
+      throw InputError(where + "expected " + std::to_string(header.size()) + " fields, found " + std::to_string(f.size()));
+    auto number = [&](const char* name) {
+      double v = 0;
+      if (!parse_double(f[column.at(name)], v) || !std::isfinite(v))
+        throw InputError(where + name + " '" + f[column.at(name)] + "' is not a finite number");
+      return v;
+    };
+    PoseRow r;
+    r.line = line_number;
+    r.file = f[column.at("file")];
+    if (r.file.empty()) throw InputError(where + "the file name is empty");
+    if (auto [it, fresh] = seen.emplace(r.file, line_number); !fresh)
+      throw InputError(where + r.file + " already has a pose on line " + std::to_string(it->second));
+    const glm::dquat q(number("qw"), number("qx"), number("qy"), number("qz"));
+    const double norm = std::sqrt(q.w * q.w + q.x * q.x + q.y * q.y + q.z * q.z);
+    if (std::abs(norm - 1.0) > 1e-3)
+      throw InputError(where + "the quaternion of " + r.file + " has length " + std::to_string(norm) +
+                       "; give R_world_camera as a unit quaternion qw,qx,qy,qz");
+    r.rotation = q / norm;
+    if (positions == 3) r.position = glm::dvec3(number("x"), number("y"), number("z"));
+    if (column.count("exposure")) {
+      r.exposure = number("exposure");
+      if (!(r.exposure > 0)) throw InputError(where + "exposure must be positive (video linear value per unit radiance)");
+    }
+    if (column.count("station")) {
+      const std::string& s = f[column.at("station")];
+      int v = 0;
+      const auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
+      if (ec != std::errc() || end != s.data() + s.size()) throw InputError(where + "station '" + s + "' is not an integer");
+      r.station = v;
+    }
+    rows.push_back(r);
+  }
+  if (rows.empty()) throw InputError(path + ": no poses; one row per image is needed");
+  return rows;
+}
+
+std::string key_of(const fs::path& p) { return p.lexically_normal().string(); }
+
+}  // namespace
+
+SweepInput images_sweep_input(const ImagesInputOptions& o, int width) {
+  if (o.poses.empty()) throw InputError("--images needs --poses POSES.csv (file,qw,qx,qy,qz per image)");
+  if (o.camera.empty()) throw InputError("--images needs --camera CAM.yml, the calibration of the camera that took them");
+  const std::vector<PoseRow> rows = read_poses_csv(o.poses);
+  const CameraIntrinsics camera = calib::load_camera_file(o.camera).intrinsics;
+
+  capture::ImageSequenceSettings seq;
+  seq.pattern = o.images;
+  seq.fps = 1;  // times do not matter here
+  auto listing = std::make_shared<capture::ImageSequenceSource>(seq);
+  const auto& files = listing->files();
+  const cv::Size size = listing->frame_size();
+  if (camera.width != size.width || camera.height != size.height)
+    throw InputError(o.camera + ": the calibration is for " + std::to_string(camera.width) + "x" +
+                     std::to_string(camera.height) + " but " + files.front().string() + " is " +
+                     std::to_string(size.width) + "x" + std::to_string(size.height) +
+                     "; use the calibration of the camera that took the images");
+
+  // Match rows to images by path relative to the images' folder.
+  std::error_code ec;
+  const fs::path folder = fs::is_directory(o.images, ec) ? fs::path(o.images) : fs::path(o.images).parent_path();
+  std::map<std::string, int> image_index;
+  for (int i = 0; i < int(files.size()); ++i) image_index[key_of(files[i])] = i;
+  std::vector<int> row_of(files.size(), -1);
+  for (int r = 0; r < int(rows.size()); ++r) {
+    const fs::path p = folder / rows[r].file;
+    const std::string where = o.poses + ":" + std::to_string(rows[r].line) + ": ";
+    const auto it = image_index.find(key_of(p));
+    if (it == image_index.end()) {
+      if (!fs::exists(p, ec)) throw InputError(where + "the image " + p.string() + " does not exist; add it or drop the row");
+      throw InputError(where + p.string() + " is not one of the images of " + o.images + "; drop the row or widen the glob");
+    }
+    row_of[it->second] = r;
+  }
+  for (int i = 0; i < int(files.size()); ++i)
+    if (row_of[i] < 0)
+      throw InputError(o.poses + ": no pose for " + files[i].string() + "; add a row for it or move it out of " + o.images);
+
+  SweepInput in;
+  in.name = o.images;
+  in.stitch.width = width;
+  in.stitch.camera = camera;
+  in.stitch.response = o.response.empty() ? calib::srgb_response(1.0) : calib::load_camera_response(o.response);
+  in.stitch.vignetting_a = o.vignetting_a;
+  in.stitch.vignetting_b = o.vignetting_b;
+  in.tracker_noise_deg = o.tracker_noise_deg;
+  in.label_header = "file";
+  glm::dvec3 position_sum(0.0);
+  int positions = 0;
+  bool stations = false;
+  for (int i = 0; i < int(files.size()); ++i) {
+    const PoseRow& r = rows[row_of[i]];
+    in.rotations.push_back(r.rotation);
+    in.exposures.push_back(r.exposure);
+    in.labels.push_back(r.file);
+    in.groups.push_back(r.station.value_or(-1 - i));  // no station: a group of its own
+    stations = stations || r.station.has_value();
+    if (r.position) position_sum += *r.position, ++positions;
+  }
+  if (!stations) in.groups.clear();
+  if (positions > 0) in.stitch.capture_position = position_sum / double(positions);
+  const std::string pattern = o.images;
+  const int n = int(files.size());
+  in.read_frames = [pattern, n](const std::function<void(const cv::Mat&, int)>& use) {
+    capture::ImageSequenceSettings s;
+    s.pattern = pattern;
+    s.fps = 1;
+    capture::ImageSequenceSource source(s);  // InputError naming an image that does not decode or changes size
+    capture::Frame frame;
+    for (int k = 0; k < n && source.read(frame); ++k) use(frame.image, k);
+  };
+  return in;
+}
+
+void export_sweep_images(const SweepInput& in, const std::string& dir_text) {
+  const fs::path dir = dir_text;
+  std::error_code ec;
+  if (fs::exists(dir, ec)) throw InputError(dir_text + ": already exists; --export-images makes a new folder");
+  const fs::path tmp = dir.string() + ".partial";
+  fs::remove_all(tmp, ec);
+  fs::create_directories(tmp, ec);
+  if (ec) throw InputError(dir_text + ": cannot create the folder (" + ec.message() + ")");
+  try {
+    std::ofstream csv(tmp / "poses.csv");
+    csv.precision(12);
+    csv << "file,qw,qx,qy,qz,x,y,z,exposure" << (in.groups.empty() ? "" : ",station") << '\n';
+    const glm::dvec3 p = in.stitch.capture_position;
+    Progress progress("exporting", int(in.rotations.size()));
+    int done = 0;
+    in.read_frames([&](const cv::Mat& image, int k) {
+      char name[32];
+      std::snprintf(name, sizeof name, "frame-%06d.png", k);
+      if (!cv::imwrite((tmp / name).string(), image)) throw InputError((dir / name).string() + ": cannot write");
+      const glm::dquat& q = in.rotations[k];
+      csv << name << ',' << q.w << ',' << q.x << ',' << q.y << ',' << q.z << ',' << p.x << ',' << p.y << ',' << p.z
+          << ',' << in.exposures[k];
+      if (!in.groups.empty()) csv << ',' << in.groups[k];
+      csv << '\n';
+      progress.update(++done);
+    });
+    if (!csv) throw InputError(dir_text + ": cannot write poses.csv; check the disk");
+    calib::CameraFile camera;
+    camera.intrinsics = in.stitch.camera;
+    calib::save_camera_file(tmp / "camera.yml", camera);
+    if (done != int(in.rotations.size())) throw InputError(in.name + ": not every frame could be read");
+  } catch (...) {
+    fs::remove_all(tmp, ec);
+    throw;
+  }
+  fs::rename(tmp, dir);
+  spdlog::info("envmap: stitch them with: lumar envmap --images {0} --poses {0}/poses.csv --camera {0}/camera.yml "
+               "--vignetting {1} --vignetting-b {2} --out OUT.exr (and the recording's camera response, if not sRGB)",
+               dir_text, in.stitch.vignetting_a, in.stitch.vignetting_b);
+}
+
+}  // namespace lumar::app

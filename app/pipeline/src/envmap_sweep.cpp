@@ -1,0 +1,144 @@
+#include "lumar/pipeline/envmap_sweep.h"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <spdlog/spdlog.h>
+
+#include "lumar/envmap/envmap_quality.h"
+#include "lumar/envmap/hole_filling.h"
+#include "lumar/envmap/orientation_refinement.h"
+#include "lumar/base/error.h"
+#include "lumar/base/pose.h"
+
+namespace lumar::app {
+
+void check_map_width(int width) {
+  if (width <= 0 || width % 2 != 0 || width > 16384)
+    throw InputError("--width " + std::to_string(width) + ": expected an even number of pixels up to 16384");
+}
+
+Progress::Progress(std::string what, int total) : what_(std::move(what)), total_(std::max(1, total)), tty_(isatty(2)) {}
+
+void Progress::update(int done) {
+  const int tenth = done * 10 / total_;
+  if (tty_) {
+    const int filled = std::clamp(done * 30 / total_, 0, 30);
+    std::fprintf(stderr, "\r%s [%s%s] %d/%d", what_.c_str(), std::string(filled, '#').c_str(),
+                 std::string(30 - filled, ' ').c_str(), done, total_);
+    if (done == total_) std::fprintf(stderr, "\n");
+  } else if (tenth != last_tenth_) {
+    std::fprintf(stderr, "%s: %d/%d\n", what_.c_str(), done, total_);
+  }
+  last_tenth_ = tenth;
+}
+
+std::optional<double> compare_with_reference(const EnvironmentMap& map, const cv::Mat& coverage,
+                                             const std::string& reference) {
+  if (reference.empty()) return std::nullopt;
+  const EnvironmentMap source = load_environment_map(reference);
+  if (source.width % map.width != 0) {
+    spdlog::warn("envmap: not compared with {}: its width {} is not a multiple of {}", reference, source.width,
+                 map.width);
+    return std::nullopt;
+  }
+  const double error = calib::median_relative_luminance_error(map, calib::downsample_map(source, map.width), coverage);
+  spdlog::info("envmap: against {}: median relative luminance error {:.2f} % on covered pixels", reference,
+               100.0 * error);
+  return error;
+}
+
+double write_envmap_outputs(EnvironmentMap map, const cv::Mat& coverage, const EnvmapOutputOptions& o, int* filled) {
+  const int covered = cv::countNonZero(coverage);
+  int n_filled = 0;
+  if (!o.no_fill && covered > 0) n_filled = calib::fill_holes_push_pull(map, coverage);
+  save_environment_map(o.out, map);
+  if (!o.coverage.empty()) calib::write_image_atomically(o.coverage, calib::coverage_image(coverage));
+  if (!o.preview.empty()) calib::write_image_atomically(o.preview, calib::contact_sheet(map, coverage));
+  if (filled) *filled = n_filled;
+  return double(covered) / double(coverage.total());
+}
+
+namespace {
+
+void write_corrections(const SweepInput& in, const calib::RefinementResult& result, const std::string& path_text) {
+  const std::filesystem::path path = path_text, tmp = path.string() + ".tmp";
+  {
+    std::ofstream out(tmp);
+    out << in.label_header << ",correction_deg,qw,qx,qy,qz\n";
+    out.precision(12);
+    for (std::size_t k = 0; k < result.rotations.size(); ++k) {
+      const glm::dquat& q = result.rotations[k];
+      out << in.labels[k] << ',' << result.correction_deg[k] << ',' << q.w << ',' << q.x << ',' << q.y << ',' << q.z
+          << '\n';
+    }
+    if (!out) throw InputError(path_text + ": cannot write the corrections; check the folder");
+  }
+  std::filesystem::rename(tmp, path);
+}
+
+}  // namespace
+
+void stitch_sweep(const SweepInput& in, const EnvmapOutputOptions& o) {
+  const int n = int(in.rotations.size());
+  if (n == 0) throw InputError(in.name + ": no frames; a sweep needs at least one");
+  auto read_all = [&](const std::string& what, const std::function<void(const cv::Mat&, int)>& use) {
+    Progress progress(what, n);
+    int done = 0;
+    in.read_frames([&](const cv::Mat& image, int k) {
+      use(image, k);
+      progress.update(++done);
+    });
+    if (done < n)
+      throw InputError(in.name + ": only " + std::to_string(done) + " of " + std::to_string(n) +
+                       " frames could be read; the input is damaged");
+  };
+
+  std::vector<glm::dquat> rotations = in.rotations;
+  if (!o.no_refine) {
+    std::vector<calib::FrameFeatures> features(n);
+    read_all("features", [&](const cv::Mat& image, int k) {
+      features[k] = calib::extract_frame_features(image, in.stitch.camera, in.stitch.response);
+    });
+    calib::RefinementSettings rs;
+    rs.tracker_noise_deg = std::max(in.tracker_noise_deg, 0.05);
+    const auto result = calib::refine_orientations(features, in.rotations, rs, in.groups);
+    rotations = result.rotations;
+    double mean = 0, worst = 0;
+    for (double c : result.correction_deg) mean += c / n, worst = std::max(worst, c);
+    spdlog::info("envmap: refined {} frames from {} pairs ({} matches, {} frames unmatched): corrections mean {:.3f} "
+                 "deg, max {:.3f} deg; match residual {:.3f} -> {:.3f} deg RMS",
+                 n, result.pairs, result.matches, result.unmatched_frames, mean, worst, result.residual_before_deg,
+                 result.residual_after_deg);
+    if (!o.corrections.empty()) write_corrections(in, result, o.corrections);
+  }
+  // With ground truth (synthetic sweeps), say how close the rotations came.
+  double before = 0, after = 0;
+  int m = 0;
+  for (int k = 0; k < n && k < int(in.truth.size()); ++k)
+    if (in.truth[k]) {
+      before += std::pow(rotation_angle_deg(in.rotations[k], *in.truth[k]), 2);
+      after += std::pow(rotation_angle_deg(rotations[k], *in.truth[k]), 2);
+      ++m;
+    }
+  if (m > 0)
+    spdlog::info("envmap: rotation error against truth: tracker {:.3f} deg RMS, used {:.3f} deg RMS",
+                 std::sqrt(before / m), std::sqrt(after / m));
+
+  calib::EnvmapStitcher stitcher(in.stitch);
+  const auto t0 = std::chrono::steady_clock::now();
+  read_all("stitching", [&](const cv::Mat& image, int k) { stitcher.add_frame(image, rotations[k], in.exposures[k]); });
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  int filled = 0;
+  const double covered = write_envmap_outputs(stitcher.current_map(), stitcher.coverage(), o, &filled);
+  spdlog::info("envmap: wrote {} ({}x{}, {:.1f} % covered, {} pixels filled; {} frames in {:.2f} s incl. decoding)",
+               o.out, stitcher.width(), stitcher.height(), 100.0 * covered, filled, n, seconds);
+  compare_with_reference(stitcher.current_map(), stitcher.coverage(),
+                         o.reference.empty() ? in.default_reference : o.reference);
+}
+
+}  // namespace lumar::app

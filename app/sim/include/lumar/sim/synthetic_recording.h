@@ -1,0 +1,76 @@
+#pragma once
+// `lumar synth`: renders a recording whose truth is known. The proxy room is textured
+// by projecting the HDR map from its capture point, seen by the calibrated camera
+// (lens distortion, vignetting, sensor noise, 8-bit clipping) along a trajectory, with
+// the byte stream a Polhemus ISOTRAK II would send about the same motion.
+#include <cstdint>
+#include <filesystem>
+#include <functional>
+#include <opencv2/core.hpp>
+#include <string>
+
+#include "lumar/capture/recording_writer.h"
+#include "lumar/capture/session.h"
+#include "lumar/base/camera.h"
+#include "lumar/base/pose.h"
+#include "lumar/tracking/simulated_tracker.h"
+
+namespace lumar::app {
+
+struct SynthSettings {
+  std::filesystem::path scene;
+  std::filesystem::path out;
+  CameraIntrinsics camera;  // calibrated, with distortion
+  int frames = 48;
+  double fps = 24.0;
+  int supersample = 2;
+  double exposure = 0.0;             // video linear value per unit radiance; 0 = automatic
+  double read_noise = 0.002;         // linear units, standard deviation
+  double shot_noise_gain = 0.0004;   // variance per unit of linear signal
+  double vignetting_a = -0.30, vignetting_b = 0.05;
+  double tracker_noise_deg = 0.75;   // RMS rotation error
+  double position_noise_m = 0.0025;  // RMS per axis
+  double latency_ms = 20.0;          // device latency
+  double arc_deg = 60.0;             // how far the camera orbits
+  std::string codec = "mjpeg";
+  int quality = 95;
+  std::uint64_t seed = 1;
+};
+
+// OpenCV camera axes (x right, y down, z forward) looking from `eye` at `target`, world +Y up.
+Pose look_at(const glm::dvec3& eye, const glm::dvec3& target);
+
+// The tracker of a synthetic recording: the session's protocol (rate, baud, station),
+// the simulated device's own latency, its noise and seed, measuring `true_sensor_pose`.
+tracking::SimulatedTrackerOutput simulate_session_tracker(const capture::Session& session, Nanos device_latency,
+                                                          double orientation_noise_deg, double position_noise_m,
+                                                          std::uint64_t seed,
+                                                          const std::function<Pose(Nanos)>& true_sensor_pose,
+                                                          Nanos duration);
+
+// The tracker's bytes as they arrived (into tracker.raw), and the poses the real ASCII
+// parser decodes from them (into poses.csv), timestamped with `assumed_latency`: the
+// latency the recorder believed in, which need not be the simulated device's.
+void write_tracker_stream(capture::RecordingWriter& writer, const tracking::SimulatedTrackerOutput& tracker,
+                          const capture::TrackerSettings& settings, Nanos assumed_latency);
+
+// One synthetic frame: the image the camera makes of the truth at frame k, time t.
+using SyntheticFrameRenderer = std::function<cv::Mat(int k, Nanos t, const Pose& T_world_camera, cv::RNG& rng)>;
+
+// Writes a synthetic recording into `out` (which must not exist yet): session.json, the
+// simulated tracker's stream, and `frames` frames at `frame_time(k)` seen from
+// `true_camera(t)`, drawn by `render` with one noise generator seeded by `seed`. On any
+// failure the partial directory is removed and the error rethrown.
+void write_synthetic_recording(const std::filesystem::path& out, const capture::Session& session,
+                               const tracking::SimulatedTrackerOutput& tracker, const capture::RecordingSettings& video,
+                               int frames, std::uint64_t seed, const std::function<Nanos(int)>& frame_time,
+                               const std::function<Pose(Nanos)>& true_camera, const SyntheticFrameRenderer& render);
+
+// The camera's true pose at s in [0, 1] along the orbit around `target`.
+Pose orbit_camera_pose(const glm::dvec3& target, double s, double arc_deg);
+
+// Writes the recording into settings.out (which must not exist yet). Throws
+// InputError / RuntimeError; on failure the partial recording directory is removed.
+void synthesize_recording(const SynthSettings& settings);
+
+}  // namespace lumar::app

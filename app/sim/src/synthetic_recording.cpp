@@ -1,0 +1,229 @@
+#include "lumar/sim/synthetic_recording.h"
+
+#include <cmath>
+#include <opencv2/calib3d.hpp>
+#include <opencv2/imgproc.hpp>
+#include <spdlog/spdlog.h>
+
+#include "lumar/sim/envmap_view.h"
+#include "lumar/calib/undistortion.h"
+#include "lumar/capture/recording_writer.h"
+#include "lumar/capture/session.h"
+#include "lumar/base/color.h"
+#include "lumar/scene/envmap.h"
+#include "lumar/base/error.h"
+#include "lumar/render/platform/context.h"
+#include "lumar/render/renderer.h"
+#include "lumar/scene/mesh.h"
+#include "lumar/scene/scene.h"
+#include "lumar/tracking/isotrak_ascii.h"
+#include "lumar/tracking/pose_conversion.h"
+#include "lumar/tracking/simulated_tracker.h"
+#include "lumar/tracking/timestamping.h"
+
+namespace lumar::app {
+
+Pose look_at(const glm::dvec3& eye, const glm::dvec3& target) {
+  const glm::dvec3 forward = glm::normalize(target - eye);
+  const glm::dvec3 right = glm::normalize(glm::cross(forward, glm::dvec3(0, 1, 0)));
+  const glm::dvec3 down = glm::cross(forward, right);
+  Pose p;
+  p.rotation = glm::normalize(glm::quat_cast(glm::dmat3(right, down, forward)));
+  p.translation = eye;
+  return p;
+}
+
+tracking::SimulatedTrackerOutput simulate_session_tracker(const capture::Session& session, Nanos device_latency,
+                                                          double orientation_noise_deg, double position_noise_m,
+                                                          std::uint64_t seed,
+                                                          const std::function<Pose(Nanos)>& true_sensor_pose,
+                                                          Nanos duration) {
+  tracking::SimulatedTrackerSettings ts;
+  ts.rate_hz = session.tracker.rate_hz;
+  ts.baud = session.tracker.baud;
+  ts.station = session.tracker.station;
+  ts.device_latency = device_latency;
+  ts.orientation_noise_deg = orientation_noise_deg;
+  ts.position_noise_m = position_noise_m;
+  ts.seed = seed;
+  return tracking::simulate_tracker(true_sensor_pose, duration, ts);
+}
+
+void write_tracker_stream(capture::RecordingWriter& writer, const tracking::SimulatedTrackerOutput& tracker,
+                          const capture::TrackerSettings& settings, Nanos assumed_latency) {
+  tracking::OutputFormat format;
+  format.output_list = settings.output_list;
+  tracking::AsciiRecordParser parser(format, 2, settings.baud);
+  for (const auto& chunk : tracker.chunks) {
+    writer.add_tracker_bytes(chunk);
+    parser.push(chunk);
+    for (const auto& r : parser.take_all()) {
+      const Nanos t = tracking::measurement_time(r.first_byte_arrival, settings.baud, assumed_latency);
+      if (auto sample = tracking::to_pose_sample(r.record, format, t)) writer.add_pose(*sample);
+    }
+  }
+}
+
+void write_synthetic_recording(const std::filesystem::path& out, const capture::Session& session,
+                               const tracking::SimulatedTrackerOutput& tracker, const capture::RecordingSettings& video,
+                               int frames, std::uint64_t seed, const std::function<Nanos(int)>& frame_time,
+                               const std::function<Pose(Nanos)>& true_camera, const SyntheticFrameRenderer& render) {
+  try {
+    capture::RecordingWriter writer(out, capture::session_to_json(session), video);
+    write_tracker_stream(writer, tracker, session.tracker, session.rig.latency);
+    cv::RNG rng(seed);
+    for (int k = 0; k < frames; ++k) {
+      const Nanos t = frame_time(k);
+      const Pose T_world_camera = true_camera(t);
+      writer.add_frame(capture::Frame{render(k, t, T_world_camera, rng), t, k});
+      writer.add_truth(k, t, T_world_camera);
+      if ((k + 1) % std::max(1, frames / 4) == 0 || k + 1 == frames) spdlog::info("synth: frame {}/{}", k + 1, frames);
+    }
+    writer.close();
+  } catch (...) {
+    std::error_code ec;
+    std::filesystem::remove_all(out, ec);
+    throw;
+  }
+}
+
+namespace {
+
+// A pinhole camera, `supersample` times finer than `camera`, wide enough to cover
+// every ray of the distorted camera (barrel distortion sees past the pinhole frame).
+CameraIntrinsics covering_pinhole(const CameraIntrinsics& camera, int supersample) {
+  std::vector<cv::Point2f> border;
+  for (int x = 0; x < camera.width; x += 8) {
+    border.emplace_back(x, 0);
+    border.emplace_back(x, camera.height - 1);
+  }
+  for (int y = 0; y < camera.height; y += 8) {
+    border.emplace_back(0, y);
+    border.emplace_back(camera.width - 1, y);
+  }
+  border.emplace_back(camera.width - 1, camera.height - 1);
+  std::vector<cv::Point2f> normalized;
+  cv::undistortPoints(border, normalized, cv::Mat(camera.camera_matrix()), camera.distortion_coefficients());
+  float x0 = 0, x1 = 0, y0 = 0, y1 = 0;
+  for (const auto& p : normalized) {
+    x0 = std::min(x0, p.x), x1 = std::max(x1, p.x), y0 = std::min(y0, p.y), y1 = std::max(y1, p.y);
+  }
+  CameraIntrinsics pin;
+  const double s = supersample, pad = 4;  // pixels of the pinhole image beyond the rays
+  pin.fx = camera.fx * s;
+  pin.fy = camera.fy * s;
+  pin.cx = -x0 * pin.fx + pad;
+  pin.cy = -y0 * pin.fy + pad;
+  pin.width = int(std::ceil((x1 - x0) * pin.fx + 2 * pad));
+  pin.height = int(std::ceil((y1 - y0) * pin.fy + 2 * pad));
+  return pin;
+}
+
+// Radiance (linear, scene units) to an 8-bit frame as the camera would record it.
+cv::Mat expose(const cv::Mat& radiance_bgr, const CameraIntrinsics& camera, const SynthSettings& s,
+               double exposure, cv::RNG& rng) {
+  calib::SensorModel sensor;
+  sensor.read_noise = s.read_noise;
+  sensor.shot_noise_gain = s.shot_noise_gain;
+  sensor.vignetting_a = s.vignetting_a;
+  sensor.vignetting_b = s.vignetting_b;
+  return calib::expose_8bit(radiance_bgr, camera, sensor, exposure, rng);
+}
+
+// Where the camera looks: the foot of the first virtual object (the centre of its
+// world bounding box, at its lowest point), else the middle of the movement box.
+glm::dvec3 scene_target(const Scene& scene) {
+  if (scene.objects.empty()) return 0.5 * (scene.movement_min + scene.movement_max);
+  const SceneObject& object = scene.objects.front();
+  const auto [lo, hi] = transformed(load_mesh(object.mesh), object.T_world_model).bounds();
+  return {0.5 * (lo.x + hi.x), lo.y, 0.5 * (lo.z + hi.z)};
+}
+
+}  // namespace
+
+Pose orbit_camera_pose(const glm::dvec3& target, double s, double arc_deg) {
+  // An arc around the target that ends with the table block hiding part of the object,
+  // slowly descending, with a slight bob so motion is not planar.
+  const double start_deg = 100.0 - arc_deg;
+  const double az = glm::radians(start_deg + arc_deg * s);
+  const double radius = 1.55;
+  const double height = 1.25 - 0.15 * s + 0.03 * std::sin(6.0 * s);
+  const glm::dvec3 eye = target + glm::dvec3(radius * std::sin(az), 0.0, radius * std::cos(az)) +
+                         glm::dvec3(0, height - target.y, 0);
+  return look_at(eye, target + glm::dvec3(0, 0.08, 0));
+}
+
+void synthesize_recording(const SynthSettings& s) {
+  if (s.frames < 2) throw InputError("--frames: need at least 2 frames");
+  if (s.fps <= 0) throw InputError("--fps: must be positive");
+  if (std::filesystem::exists(s.out))
+    throw InputError(s.out.string() + ": already exists; choose a new recording directory");
+  const Scene scene = load_scene(s.scene);
+  EnvironmentMap map = load_environment_map(scene.environment_map);
+  map.capture_position = scene.capture_position;
+  map.azimuth_offset_deg = scene.azimuth_offset_deg;
+  if (scene.room_mesh.empty()) throw InputError(s.scene.string() + ": synth needs a proxy room (room.mesh)");
+  const Mesh room = transformed(load_mesh(scene.room_mesh), glm::dmat4(glm::dmat3(scene.room_scale)));
+
+  auto context = gl::create_headless_context();
+  const CameraIntrinsics pinhole = covering_pinhole(s.camera, s.supersample);
+  gl::Renderer renderer(pinhole);
+  renderer.set_room(room);
+  renderer.set_environment(map);
+
+  // The rig: transmitter on the table, +Z (Polhemus down) along world -Y; the sensor
+  // clipped to the camera a few centimetres away, turned 90 degrees.
+  capture::Session session;
+  session.camera = s.camera;
+  session.rig.T_world_transmitter = Pose{axis_angle_deg({1, 0, 0}, 90), {0.85, 0.72, -0.75}};
+  session.rig.T_sensor_camera = Pose{axis_angle_deg({0, 0, 1}, 90), {0.03, 0.05, -0.02}};
+  session.rig.latency = seconds_to_nanos(s.latency_ms * 1e-3);
+  session.scene =
+      std::filesystem::relative(std::filesystem::absolute(s.scene), std::filesystem::absolute(s.out)).string();
+  session.extra["source"] = "lumar synth";
+  session.extra["synth"] = {{"frames", s.frames},          {"fps", s.fps},
+                            {"tracker_noise_deg", s.tracker_noise_deg},
+                            {"position_noise_m", s.position_noise_m},
+                            {"read_noise", s.read_noise},  {"shot_noise_gain", s.shot_noise_gain},
+                            {"arc_deg", s.arc_deg},        {"seed", s.seed}};
+
+  const glm::dvec3 target = scene_target(scene);
+  const Nanos start = seconds_to_nanos(0.1);  // tracker runs before the first frame
+  const Nanos frame_period = seconds_to_nanos(1.0 / s.fps);
+  const Nanos duration = start + frame_period * s.frames + seconds_to_nanos(0.1);
+  const double clip_seconds = nanos_to_seconds(frame_period * (s.frames - 1));
+  auto true_camera = [&](Nanos t) {
+    const double u = std::clamp(nanos_to_seconds(t - start) / clip_seconds, 0.0, 1.0);
+    return orbit_camera_pose(target, u, s.arc_deg);
+  };
+
+  const auto tracker = simulate_session_tracker(session, session.rig.latency, s.tracker_noise_deg, s.position_noise_m,
+                                                s.seed, [&](Nanos t) { return session.rig.sensor_pose(true_camera(t)); },
+                                                duration);
+
+  // Exposure: the first view's mean radiance becomes 18 % grey unless given.
+  double exposure = s.exposure;
+  if (exposure <= 0) {
+    const cv::Mat first = renderer.render_room_radiance(pinhole, true_camera(start));
+    const cv::Scalar mean = cv::mean(first);
+    const double luminance = 0.0722 * mean[0] + 0.7152 * mean[1] + 0.2126 * mean[2];
+    if (!(luminance > 0)) throw InputError(s.scene.string() + ": the first view of the room is black");
+    exposure = 0.18 / luminance;
+  }
+  session.radiometry.exposure = exposure;
+  session.radiometry.vignetting_a = s.vignetting_a;
+  session.radiometry.vignetting_b = s.vignetting_b;
+
+  const capture::RecordingSettings video{
+      .codec = s.codec, .quality = s.quality, .fps = s.fps, .size = cv::Size(s.camera.width, s.camera.height)};
+  write_synthetic_recording(
+      s.out, session, tracker, video, s.frames, s.seed, [&](int k) { return start + frame_period * k; }, true_camera,
+      [&](int, Nanos, const Pose& T_world_camera, cv::RNG& rng) {
+        const cv::Mat radiance = renderer.render_room_radiance(pinhole, T_world_camera);
+        return expose(calib::distort_image(radiance, pinhole, s.camera), s.camera, s, exposure, rng);
+      });
+  spdlog::info("synth: wrote {} ({} frames, exposure {:.4g}, tracker {} records)", s.out.string(), s.frames,
+               exposure, tracker.noisy_samples.size());
+}
+
+}  // namespace lumar::app

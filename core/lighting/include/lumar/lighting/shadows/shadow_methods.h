@@ -1,0 +1,99 @@
+#pragma once
+// Shadow attenuation (E_with / E_without per RGB channel) of receiver points by a
+// scene's virtual objects, three ways:
+//   lines     - this project's method: precomputed radiosity lines, culled by a shaft
+//               hierarchy, traced against the objects' meshes (shadow_occlusion.h);
+//   reference - brute force: one ray per emitter texel per point, against the proxy and
+//               the objects' meshes (ground truth for the same emitters);
+//   sphere    - the 2004 method: emitters thresholded to the map's bright parts, one line
+//               per receiver and patch, blocked when it meets the object's bounding sphere.
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "lumar/scene/envmap.h"
+#include "lumar/scene/mesh.h"
+#include "lumar/lighting/ray_scene.h"
+#include "lumar/scene/scene.h"
+#include "lumar/lighting/shadows/shadow_emitters.h"
+#include "lumar/lighting/shadows/shadow_lines.h"
+
+namespace lumar {
+
+struct BoundingSphere {
+  glm::vec3 centre{0.0f};
+  float radius = 0.0f;
+};
+// Sphere around the posed mesh (centre of its world box, radius to the farthest vertex).
+BoundingSphere bounding_sphere(const Mesh& model, const glm::dmat4& T_world_model);
+
+// Exact visibility over every texel of `emitters` (ray per texel against the proxy and
+// against `occluders`); parallel (TBB).
+std::vector<glm::vec3> reference_attenuation(const std::vector<glm::vec3>& positions,
+                                             const std::vector<glm::vec3>& normals, const Emitters& emitters,
+                                             const RayScene& proxy, const RayScene& occluders);
+
+// The 2004 baseline: `emitters` are the thresholded ones (one sample per patch).
+std::vector<glm::vec3> sphere_attenuation(const std::vector<glm::vec3>& positions,
+                                          const std::vector<glm::vec3>& normals, const Emitters& emitters,
+                                          const RayScene& proxy, const std::vector<BoundingSphere>& occluders);
+
+// Emitter settings of the 2004 baseline: texels above 4x the mean luminance, 50
+// patches, one line per receiver and patch.
+EmitterOptions sphere_baseline_emitter_options();
+
+enum class ShadowMethod { Lines, Reference, Sphere };
+// "lines", "reference" or "sphere"; throws InputError otherwise.
+ShadowMethod parse_shadow_method(const std::string& name);
+
+// What every method needs from a scene manifest: the map, the proxy room (world), the
+// virtual objects in their poses.
+class ShadowScene {
+ public:
+  struct Object {
+    std::string name;
+    Mesh model;
+    glm::dmat4 T_world_model{1.0};
+  };
+
+  explicit ShadowScene(const Scene& scene);
+  // Parts built in code (tests): a map, a world-space proxy (may be empty), objects.
+  ShadowScene(EnvironmentMap map, bool distant, Mesh room_world, std::vector<Object> objects,
+              ShadowRegions regions = {});
+
+  const EnvironmentMap& map() const { return map_; }
+  bool distant() const { return distant_; }
+  const Mesh& room() const { return room_; }
+  const RayScene& proxy() const { return *proxy_; }
+  const std::vector<Object>& objects() const { return objects_; }
+  const ShadowRegions& regions() const { return regions_; }
+
+  // The receiver mesh: the manifest's receiver boxes, or the floor under the movement box.
+  Mesh receivers() const;
+  // Emitters ranked for receivers around these points (their mean position and normal).
+  Emitters emitters(const std::vector<glm::vec3>& positions, const std::vector<glm::vec3>& normals,
+                    EmitterOptions options = {}) const;
+  // The objects as Embree instances in their poses.
+  std::unique_ptr<RayScene> occluders() const;
+
+ private:
+  EnvironmentMap map_;
+  bool distant_ = false;
+  Mesh room_;
+  std::unique_ptr<RayScene> proxy_;
+  std::vector<Object> objects_;
+  ShadowRegions regions_;
+  glm::dvec3 movement_min_{0.0}, movement_max_{0.0};
+};
+
+struct ShadowMethodOptions {
+  EmitterOptions emitters;
+  ShadowLineOptions lines;
+};
+
+// Attenuation of each point (unit normals) by the scene's objects in their poses.
+std::vector<glm::vec3> shadow_attenuation(const ShadowScene& scene, const std::vector<glm::vec3>& positions,
+                                          const std::vector<glm::vec3>& normals, ShadowMethod method,
+                                          const ShadowMethodOptions& options = {});
+
+}  // namespace lumar

@@ -1,0 +1,67 @@
+#pragma once
+// The overlay for one scene and one camera: proxy room for occlusion, virtual objects
+// shaded from the environment map, composited over undistorted video. Set up once,
+// then one call per frame. Needs a current OpenGL context (gl/context.h).
+#include <memory>
+#include <optional>
+#include <opencv2/core.hpp>
+#include <vector>
+
+#include "lumar/base/camera.h"
+#include "lumar/render/renderer.h"
+#include "lumar/scene/scene.h"
+#include "lumar/lighting/sh.h"
+
+namespace lumar {
+
+class LineShadows;
+class ObjectShadows;
+class IrradianceVolume;
+
+class Compositor {
+ public:
+  // `output_camera`: the undistorted camera the renderer draws with. `map_x`, `map_y`:
+  // for each output pixel, where to sample the distorted video (may be empty when the
+  // video is already undistorted).
+  Compositor(const Scene& scene, const CameraIntrinsics& output_camera, const cv::Mat& map_x,
+             const cv::Mat& map_y);
+
+  // Composites one BGR8 video frame seen from T_world_camera (nullopt: no pose, the
+  // undistorted video alone); `exposure` is the video's linear value per unit of scene radiance.
+  cv::Mat composite(const cv::Mat& video_bgr8, const std::optional<Pose>& T_world_camera, double exposure,
+                    gl::OverlayTimings* timings = nullptr);
+
+  // Moves object `index` (manifest order): the renderer and the shadow lines follow; the
+  // shadows are recomputed in the next composite() only if a pose changed.
+  void set_object_pose(std::size_t index, const glm::dmat4& T_world_model);
+  // Soft shadows of the objects on the receivers and, with two objects or more, on each
+  // other (docs/shadows.md); on by default.
+  void set_shadows_enabled(bool on);
+  // The shadow lines, or nullptr when the scene has no receivers.
+  const LineShadows* shadows() const { return shadows_.get(); }
+  // The objects' shadows on each other, or nullptr with fewer than two objects.
+  const ObjectShadows* object_shadows() const { return object_shadows_.get(); }
+
+  gl::Renderer& renderer() { return *renderer_; }
+  const CameraIntrinsics& output_camera() const { return camera_; }
+  const SH9& lighting_sh() const { return sh_; }
+  // The irradiance volume that shades the objects per pixel (built for the scene's
+  // movement box, or loaded from the cache), or nullptr when lighting.method is "sh9".
+  const IrradianceVolume* irradiance_volume() const { return volume_.get(); }
+  // A few hundred surface points of the virtual objects, world coordinates, for
+  // checking where they project.
+  const std::vector<glm::dvec3>& object_points() const { return object_points_; }
+
+ private:
+  CameraIntrinsics camera_;
+  SH9 sh_;
+  std::unique_ptr<gl::Renderer> renderer_;
+  std::shared_ptr<IrradianceVolume> volume_;  // shared_ptr: incomplete here
+  void build_shadows(const Scene& scene);
+  std::vector<glm::dvec3> object_points_;
+  std::shared_ptr<LineShadows> shadows_;  // shared_ptr: LineShadows is incomplete here
+  std::shared_ptr<ObjectShadows> object_shadows_;
+  bool shadows_enabled_ = true, shadows_uploaded_ = false, object_shadows_uploaded_ = false;
+};
+
+}  // namespace lumar

@@ -1,0 +1,116 @@
+#pragma once
+// The OpenGL compositor: undistorted video as background, the proxy room as an
+// occluder (depth only), virtual diffuse objects lit by order-2 SH irradiance, all
+// composited in linear light and encoded to sRGB 8-bit. Also renders the proxy room's
+// projected radiance (for synthesis) and per-pixel world positions (for tests).
+//
+// Create, use and destroy a Renderer while the same gl::Context is current.
+// Images are OpenCV-shaped: top row first, BGR channel order.
+#include <array>
+#include <glm/glm.hpp>
+#include <memory>
+#include <optional>
+#include <span>
+#include <opencv2/core.hpp>
+#include <vector>
+
+#include "lumar/base/camera.h"
+#include "lumar/scene/envmap.h"
+#include "lumar/scene/mesh.h"
+#include "lumar/base/pose.h"
+#include "lumar/lighting/sh.h"
+
+namespace lumar {
+class IrradianceVolume;
+}
+
+namespace lumar::gl {
+
+// Wall time of each stage of render_overlay. Asking for timings makes the stages wait
+// for each other (glFinish between them), so ask only when profiling.
+struct OverlayTimings {
+  double upload_ms = 0, background_ms = 0, depth_ms = 0, objects_ms = 0, readback_ms = 0;
+};
+
+// How the camera turned light into video, so that rendered pixels look like the
+// camera's: its response (8-bit code -> linear value) and its radial vignetting.
+struct VideoRadiometry {
+  // linear_of_code[channel][code], channels B, G, R (OpenCV order), non-decreasing.
+  // Empty: the default sRGB curve.
+  std::vector<std::array<float, 256>> linear_of_code;
+  // Gain 1 + a r^2 + b r^4, r = distance from the principal point over the half-diagonal,
+  // in the pixels of `video_camera` (the distorted camera the undistortion map samples).
+  // Without an undistortion map or a valid video_camera: the output camera's pixels.
+  double vignetting_a = 0.0, vignetting_b = 0.0;
+  CameraIntrinsics video_camera;
+};
+
+class Renderer {
+ public:
+  // `camera` is the undistorted output camera (its distortion is ignored); output
+  // images are camera.width x camera.height. Throws InputError for an invalid camera.
+  explicit Renderer(const CameraIntrinsics& camera);
+  ~Renderer();
+  Renderer(const Renderer&) = delete;
+  Renderer& operator=(const Renderer&) = delete;
+
+  // Proxy room in world coordinates (metres). An empty mesh means no occluder.
+  void set_room(const Mesh& room_world);
+  // Radiance map projected onto the room by render_room_radiance.
+  void set_environment(const EnvironmentMap& map);
+  // A virtual object in model units; returns its id. Its pose starts as identity, its
+  // material as albedo 0.8 under no light.
+  int add_object(const Mesh& mesh_model);
+  void set_object_pose(int id, const glm::dmat4& T_world_model);
+  void set_object_material(int id, const glm::vec3& albedo, const SH9& irradiance_sh);
+  // Per vertex (mesh order), the share of the light the object still gets when the
+  // other objects block some of it (object_shadows.h): multiplies its irradiance.
+  // 1 until set; throws InputError unless there is one value per vertex.
+  void set_object_light_attenuation(int id, std::span<const glm::vec3> attenuation);
+  // Shade every object per pixel from this irradiance volume (uploaded as textures;
+  // core/irradiance_volume.h) instead of its SH9; nullptr goes back to SH9.
+  void set_irradiance_volume(const IrradianceVolume* volume);
+
+  // Shadow receivers (world mesh of real surfaces): in render_overlay the video under
+  // them is multiplied by their per-vertex attenuation E_with / E_without (1 until set).
+  // An empty mesh removes them.
+  void set_receivers(const Mesh& receivers_world);
+  void set_receiver_attenuation(std::span<const glm::vec3> attenuation);
+
+  // Where each output pixel samples the distorted video: cv::initUndistortRectifyMap's
+  // map1/map2 as CV_32FC1, output size. Without it the video is drawn unwarped
+  // (scaled to the output size).
+  void set_undistortion_map(const cv::Mat& map_x, const cv::Mat& map_y);
+
+  // The video's response and vignetting (default: sRGB, no vignetting). Video pixels
+  // pass through unchanged; rendered pixels get the vignetting and the response.
+  // Throws InputError for a table that is not 3 x 256 finite non-decreasing values.
+  void set_video_radiometry(const VideoRadiometry& radiometry);
+
+  // One composited frame (BGR8, output size). `video_bgr8` is the distorted video frame
+  // (CV_8UC3, the undistortion map's source size); `exposure` is the video's linear
+  // value per unit of scene radiance. Without a pose (nullopt) the frame shows the
+  // undistorted video alone: no object is drawn where the camera cannot be placed.
+  cv::Mat render_overlay(const cv::Mat& video_bgr8, const std::optional<Pose>& T_world_camera, double exposure,
+                         OverlayTimings* timings = nullptr);
+
+  // Linear radiance of the proxy room, textured by projecting the environment map
+  // from its capture point, seen by a pinhole `camera` (any size; distortion ignored).
+  // CV_32FC3 BGR; pixels that see no room are 0.
+  cv::Mat render_room_radiance(const CameraIntrinsics& camera, const Pose& T_world_camera);
+
+  // World position of the visible virtual objects after proxy occlusion: CV_32FC4
+  // (x, y, z, 1) where covered, (0, 0, 0, 0) elsewhere.
+  cv::Mat render_object_world_positions(const Pose& T_world_camera);
+  // CV_8UC1, 255 where a virtual object is visible after proxy occlusion.
+  cv::Mat render_object_mask(const Pose& T_world_camera);
+
+  // Clip planes used for every view, metres.
+  static constexpr double kNear = 0.02, kFar = 200.0;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace lumar::gl

@@ -1,0 +1,128 @@
+#include "lumar/render/compositor.h"
+
+#include <spdlog/spdlog.h>
+
+#include "lumar/scene/envmap.h"
+#include "lumar/lighting/irradiance_scene.h"
+#include "lumar/lighting/irradiance_volume.h"
+#include "lumar/scene/mesh.h"
+#include "lumar/lighting/shadows/object_shadows.h"
+#include "lumar/lighting/shadows/shadow_methods.h"
+#include "lumar/lighting/shadows/shadow_occlusion.h"
+
+namespace lumar {
+
+Compositor::Compositor(const Scene& scene, const CameraIntrinsics& output_camera, const cv::Mat& map_x,
+                       const cv::Mat& map_y)
+    : camera_(output_camera.without_distortion()) {
+  EnvironmentMap map = load_environment_map(scene.environment_map);
+  map.capture_position = scene.capture_position;
+  map.azimuth_offset_deg = scene.azimuth_offset_deg;
+  sh_ = project_radiance_sh9(map);
+
+  renderer_ = std::make_unique<gl::Renderer>(camera_);
+  Mesh room;
+  if (!scene.room_mesh.empty()) {
+    const double s = scene.room_scale;
+    room = transformed(load_mesh(scene.room_mesh), glm::dmat4(glm::dmat3(s)));
+    renderer_->set_room(room);
+  }
+  // Spatially varying light: the irradiance volume over the movement box (cached on disk).
+  if (const std::string method = scene_lighting_method(scene); method != "sh9") {
+    const VolumeSettings settings = scene_volume_settings(scene, method);
+    const bool distant = scene.distant_map || room.triangle_count() == 0;
+    const auto radiance = distant ? std::make_unique<RoomRadiance>(map, settings.radiance)
+                                  : std::make_unique<RoomRadiance>(map, room, settings.radiance);
+    bool loaded = false;
+    volume_ = std::make_shared<IrradianceVolume>(
+        cached_irradiance_volume(*radiance, scene.movement_min, scene.movement_max, settings, {}, &loaded));
+    renderer_->set_irradiance_volume(volume_.get());
+    spdlog::debug("irradiance volume ({}): {} probes, {}", settings.describe(), volume_->stats().probes,
+                  loaded ? "loaded from the cache" : "built");
+  }
+  renderer_->set_environment(map);
+  if (!map_x.empty()) renderer_->set_undistortion_map(map_x, map_y);
+
+  for (const SceneObject& object : scene.objects) {
+    const Mesh mesh = load_mesh(object.mesh);
+    const int id = renderer_->add_object(mesh);
+    renderer_->set_object_pose(id, object.T_world_model);
+    renderer_->set_object_material(id, object.albedo, sh_);
+    // Every k-th vertex, so that checks see the whole object at a bounded cost.
+    const std::size_t step = std::max<std::size_t>(1, mesh.positions.size() / 200);
+    for (std::size_t i = 0; i < mesh.positions.size(); i += step)
+      object_points_.push_back(glm::dvec3(object.T_world_model * glm::dvec4(glm::dvec3(mesh.positions[i]), 1.0)));
+    spdlog::debug("object '{}': {} triangles", object.name, mesh.triangle_count());
+  }
+  build_shadows(scene);
+}
+
+// Precomputes the shadow lines from the scene's receivers to its emitters (the objects
+// are the occluders), and with two objects or more their shadows on each other.
+void Compositor::build_shadows(const Scene& scene) {
+  const ShadowScene shadow_scene(scene);
+  const auto& objects = shadow_scene.objects();
+  const Mesh receivers = shadow_scene.receivers();
+  const bool on_receivers = receivers.triangle_count() > 0 && !objects.empty();
+  if (!on_receivers && objects.size() < 2) return;
+  // Emitters ranked for the receivers or, without any, for the objects' own surfaces.
+  Mesh around = receivers;
+  if (!on_receivers)
+    for (const auto& o : objects) {
+      const Mesh posed = transformed(o.model, o.T_world_model);
+      around.positions.insert(around.positions.end(), posed.positions.begin(), posed.positions.end());
+      around.normals.insert(around.normals.end(), posed.normals.begin(), posed.normals.end());
+    }
+  const Emitters emitters = shadow_scene.emitters(around.positions, around.normals);
+  if (on_receivers) {
+    shadows_ = std::make_shared<LineShadows>(
+        build_shadow_lines(receivers.positions, receivers.normals, emitters, shadow_scene.proxy()));
+    for (const auto& o : objects) shadows_->add_object(o.model, o.T_world_model);
+    renderer_->set_receivers(receivers);
+    spdlog::debug("shadows: {} receivers, {} emitter patches, {} lines", receivers.positions.size(),
+                  emitters.patches.size(), shadows_->lines().lines.size());
+  }
+  if (objects.size() >= 2) {
+    object_shadows_ = std::make_shared<ObjectShadows>(emitters);
+    for (const auto& o : objects) object_shadows_->add_object(o.model, o.T_world_model);
+    spdlog::debug("objects shadow each other: {} objects, {} emitter samples", objects.size(),
+                  emitters.samples.size());
+  }
+}
+
+void Compositor::set_object_pose(std::size_t index, const glm::dmat4& T_world_model) {
+  renderer_->set_object_pose(int(index), T_world_model);
+  if (shadows_) shadows_->set_object_pose(int(index), T_world_model);
+  if (object_shadows_) object_shadows_->set_object_pose(int(index), T_world_model);
+}
+
+void Compositor::set_shadows_enabled(bool on) {
+  if (on == shadows_enabled_) return;
+  shadows_enabled_ = on;
+  shadows_uploaded_ = object_shadows_uploaded_ = false;
+  if (shadows_ && !on) {
+    const std::vector<glm::vec3> ones(shadows_->attenuation().size(), glm::vec3(1.0f));
+    renderer_->set_receiver_attenuation(ones);
+  }
+  if (object_shadows_ && !on)
+    for (std::size_t i = 0; i < object_shadows_->object_count(); ++i) {
+      const std::vector<glm::vec3> ones(object_shadows_->vertex_attenuation(int(i)).size(), glm::vec3(1.0f));
+      renderer_->set_object_light_attenuation(int(i), ones);
+    }
+}
+
+cv::Mat Compositor::composite(const cv::Mat& video_bgr8, const std::optional<Pose>& T_world_camera, double exposure,
+                              gl::OverlayTimings* timings) {
+  if (shadows_ && shadows_enabled_ && (shadows_->update() || !shadows_uploaded_)) {
+    renderer_->set_receiver_attenuation(shadows_->attenuation());
+    shadows_uploaded_ = true;
+  }
+  if (object_shadows_ && shadows_enabled_ && (object_shadows_->update() || !object_shadows_uploaded_)) {
+    for (std::size_t i = 0; i < object_shadows_->object_count(); ++i)
+      renderer_->set_object_light_attenuation(int(i), object_shadows_->vertex_attenuation(int(i)));
+    object_shadows_uploaded_ = true;
+  }
+  return renderer_->render_overlay(video_bgr8, T_world_camera, exposure, timings);
+}
+
+}  // namespace lumar

@@ -1,0 +1,54 @@
+#include "gpu_mesh.h"
+
+#include <string>
+
+#include "lumar/base/error.h"
+
+namespace lumar::gl {
+
+GpuMesh::GpuMesh(const Mesh& mesh, const char* what) {
+  if (mesh.indices.size() % 3 != 0)
+    throw InputError(std::string(what) + ": index count is not a multiple of three; pass whole triangles");
+  if (!mesh.normals.empty() && mesh.normals.size() != mesh.positions.size())
+    throw InputError(std::string(what) + ": " + std::to_string(mesh.normals.size()) + " normals for " +
+                     std::to_string(mesh.positions.size()) + " positions; give one normal per vertex");
+  for (std::uint32_t i : mesh.indices)
+    if (i >= mesh.positions.size())
+      throw InputError(std::string(what) + ": vertex index " + std::to_string(i) + " out of range (" +
+                       std::to_string(mesh.positions.size()) + " vertices); the mesh is corrupt");
+  if (mesh.indices.empty()) return;
+
+  vertex_array_ = create_vertex_array();
+  const GLuint vao = vertex_array_.get();
+  positions_ = create_buffer(mesh.positions.data(), mesh.positions.size() * sizeof(glm::vec3));
+  attach_vec3_attribute(vao, 0, positions_.get());
+  if (!mesh.normals.empty()) {
+    normals_ = create_buffer(mesh.normals.data(), mesh.normals.size() * sizeof(glm::vec3));
+    attach_vec3_attribute(vao, 1, normals_.get());
+  }
+  indices_ = create_buffer(mesh.indices.data(), mesh.indices.size() * sizeof(std::uint32_t));
+  glVertexArrayElementBuffer(vao, indices_.get());
+  index_count_ = GLsizei(mesh.indices.size());
+  vertex_count_ = mesh.positions.size();
+}
+
+void GpuMesh::set_light_attenuation(std::span<const glm::vec3> attenuation) {
+  if (attenuation.size() != vertex_count_)
+    throw InputError(std::to_string(attenuation.size()) + " light attenuation values for a mesh of " +
+                     std::to_string(vertex_count_) + " vertices; pass one per vertex");
+  if (empty()) return;
+  if (!attenuation_) {
+    attenuation_ = create_buffer(attenuation.data(), attenuation.size_bytes(), GL_DYNAMIC_STORAGE_BIT);
+    attach_vec3_attribute(vertex_array_.get(), 2, attenuation_.get());
+  } else {
+    glNamedBufferSubData(attenuation_.get(), 0, GLsizeiptr(attenuation.size_bytes()), attenuation.data());
+  }
+}
+
+void GpuMesh::draw() const {
+  if (empty()) return;
+  glBindVertexArray(vertex_array_.get());
+  glDrawElements(GL_TRIANGLES, index_count_, GL_UNSIGNED_INT, nullptr);
+}
+
+}  // namespace lumar::gl

@@ -1,0 +1,478 @@
+#include "lumar/render/renderer.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <chrono>
+#include <glm/gtc/matrix_transform.hpp>
+#include <glm/gtc/type_ptr.hpp>
+#include <string>
+#include <vector>
+
+#include "gl_util.h"
+#include "gpu_mesh.h"
+#include "irradiance_textures.h"
+#include "shaders.h"
+#include "shadow_pass.h"
+#include "lumar/base/error.h"
+
+namespace lumar::gl {
+namespace {
+
+// An offscreen framebuffer: one colour texture, optionally a 32-bit float depth texture.
+struct RenderTarget {
+  int width = 0, height = 0;
+  GlName framebuffer, color, depth;
+
+  RenderTarget() = default;
+  RenderTarget(int w, int h, GLenum color_format, bool with_depth, const char* what)
+      : width(w), height(h) {
+    framebuffer = create_framebuffer();
+    color = create_texture_2d(color_format, w, h, GL_NEAREST, GL_CLAMP_TO_EDGE, GL_CLAMP_TO_EDGE);
+    glNamedFramebufferTexture(framebuffer.get(), GL_COLOR_ATTACHMENT0, color.get(), 0);
+    if (with_depth) {
+      depth = create_texture_2d(GL_DEPTH_COMPONENT32F, w, h, GL_NEAREST, GL_CLAMP_TO_EDGE,
+                                GL_CLAMP_TO_EDGE);
+      glNamedFramebufferTexture(framebuffer.get(), GL_DEPTH_ATTACHMENT, depth.get(), 0);
+    }
+    glNamedFramebufferDrawBuffer(framebuffer.get(), GL_COLOR_ATTACHMENT0);
+    glNamedFramebufferReadBuffer(framebuffer.get(), GL_COLOR_ATTACHMENT0);
+    check_framebuffer(framebuffer.get(), what);
+  }
+
+  // Binds for drawing, sets the viewport, clears colour to zero and depth to far.
+  void begin() const {
+    glBindFramebuffer(GL_FRAMEBUFFER, framebuffer.get());
+    glViewport(0, 0, width, height);
+    const float zero[4] = {0, 0, 0, 0};
+    glClearNamedFramebufferfv(framebuffer.get(), GL_COLOR, 0, zero);
+    if (depth) {
+      const float far = 1.0f;
+      glClearNamedFramebufferfv(framebuffer.get(), GL_DEPTH, 0, &far);
+    }
+  }
+};
+
+GLint uniform(GLuint program, const char* name) { return glGetUniformLocation(program, name); }
+
+// Wall-clock stage timer; waits for the GPU at each mark so the stages are separable.
+class StageClock {
+ public:
+  explicit StageClock(bool enabled) : enabled_(enabled), last_(now()) {}
+  void mark(double* ms) {
+    if (!enabled_) return;
+    glFinish();
+    const auto t = now();
+    *ms = std::chrono::duration<double, std::milli>(t - last_).count();
+    last_ = t;
+  }
+
+ private:
+  static std::chrono::steady_clock::time_point now() { return std::chrono::steady_clock::now(); }
+  bool enabled_;
+  std::chrono::steady_clock::time_point last_;
+};
+
+// The bound framebuffer as floats, top row first (GL rows run bottom-up).
+cv::Mat read_float_pixels(int width, int height, GLenum format, int cv_type, const char* what) {
+  cv::Mat out(height, width, cv_type);
+  glPixelStorei(GL_PACK_ALIGNMENT, 4);
+  glPixelStorei(GL_PACK_ROW_LENGTH, 0);
+  glReadPixels(0, 0, width, height, format, GL_FLOAT, out.data);
+  check_gl_errors(what);
+  cv::flip(out, out, 0);
+  return out;
+}
+
+}  // namespace
+
+struct Renderer::Impl {
+  struct Object {
+    GpuMesh mesh;
+    glm::mat4 model{1.0f};
+    glm::mat3 normal_matrix{1.0f};
+    glm::vec3 albedo{0.8f};
+    std::array<glm::vec3, 9> sh{};
+  };
+
+  CameraIntrinsics camera;
+  GlName empty_vertex_array;  // core profile needs one bound even for attribute-less draws
+  GlName background, depth_only, shaded_object, world_position, room_radiance, encode;
+  GpuMesh room;
+  std::unique_ptr<ShadowPass> receivers;  // shadow receivers, drawn over the video
+  std::vector<Object> objects;
+
+  GlName video;
+  int video_width = 0, video_height = 0;
+  GlName undistortion_map;
+
+  GlName response_decode, response_encode;  // empty: sRGB
+  glm::vec3 response_max{1.0f};
+  glm::vec2 vignetting{0.0f};
+  CameraIntrinsics video_camera;  // the distorted camera the vignetting is defined on
+
+  std::unique_ptr<IrradianceTextures> volume;  // shades objects when set
+  GlName environment;
+  glm::vec3 capture_position{0.0f};
+  glm::mat3 map_from_world{1.0f};
+
+  RenderTarget scene;         // linear colour (RGBA32F) and depth, output size
+  RenderTarget encoded;       // sRGB 8-bit, output size, rows flipped for read-back
+  RenderTarget room_target;   // for render_room_radiance, resized on demand
+
+  Object& object(int id, const char* where) {
+    if (id < 0 || id >= int(objects.size()))
+      throw InputError(std::string("Renderer::") + where + ": no object with id " + std::to_string(id) +
+                       "; use an id returned by add_object");
+    return objects[std::size_t(id)];
+  }
+
+  static glm::mat4 view_projection(const CameraIntrinsics& c, const Pose& T_world_camera) {
+    return glm::mat4(opengl_projection(c, kNear, kFar) * opengl_view(T_world_camera));
+  }
+
+  static void set_transform(GLuint program, const glm::mat4& model, const glm::mat3& normal_matrix,
+                            const glm::mat4& vp) {
+    glProgramUniformMatrix4fv(program, uniform(program, "model"), 1, GL_FALSE, glm::value_ptr(model));
+    glProgramUniformMatrix3fv(program, uniform(program, "normal_matrix"), 1, GL_FALSE,
+                              glm::value_ptr(normal_matrix));
+    glProgramUniformMatrix4fv(program, uniform(program, "view_projection"), 1, GL_FALSE,
+                              glm::value_ptr(vp));
+  }
+
+  // The proxy room into depth only: real surfaces hide virtual objects behind them.
+  void draw_room_depth(const glm::mat4& vp) {
+    if (room.empty()) return;
+    glUseProgram(depth_only.get());
+    set_transform(depth_only.get(), glm::mat4(1.0f), glm::mat3(1.0f), vp);
+    glColorMask(GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
+    room.draw();
+    glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+  }
+
+  void draw_objects(GLuint program, const glm::mat4& vp, bool shaded, float exposure) {
+    glUseProgram(program);
+    if (shaded) glProgramUniform1f(program, uniform(program, "exposure"), exposure);
+    if (shaded) glProgramUniform1i(program, uniform(program, "use_volume"), volume ? 1 : 0);
+    if (shaded && volume) volume->bind(program);
+    for (const Object& o : objects) {
+      set_transform(program, o.model, o.normal_matrix, vp);
+      if (shaded) {
+        glProgramUniform3fv(program, uniform(program, "albedo"), 1, glm::value_ptr(o.albedo));
+        glProgramUniform3fv(program, uniform(program, "sh"), 9, glm::value_ptr(o.sh[0]));
+      }
+      o.mesh.draw();
+    }
+  }
+
+  void draw_fullscreen() {
+    glBindVertexArray(empty_vertex_array.get());
+    glDrawArrays(GL_TRIANGLES, 0, 3);
+  }
+
+  void upload_video(const cv::Mat& frame) {
+    if (frame.cols != video_width || frame.rows != video_height) {
+      video = create_texture_2d(GL_RGB8, frame.cols, frame.rows, GL_LINEAR, GL_CLAMP_TO_EDGE,
+                                GL_CLAMP_TO_EDGE);
+      video_width = frame.cols;
+      video_height = frame.rows;
+    }
+    // Undistorted: black outside the frame, as cv::remap's default constant border.
+    // Merely scaled: the edge texels extend, so the image border is not darkened.
+    const GLint wrap = undistortion_map ? GL_CLAMP_TO_BORDER : GL_CLAMP_TO_EDGE;
+    glTextureParameteri(video.get(), GL_TEXTURE_WRAP_S, wrap);
+    glTextureParameteri(video.get(), GL_TEXTURE_WRAP_T, wrap);
+    upload_bgr8(video.get(), frame);
+  }
+
+  // Visible object positions after proxy occlusion, into `scene`; RGBA32F, row 0 at the bottom.
+  void draw_positions(const Pose& T_world_camera) {
+    const glm::mat4 vp = view_projection(camera, T_world_camera);
+    scene.begin();
+    glEnable(GL_DEPTH_TEST);
+    glDepthFunc(GL_LESS);
+    glDepthMask(GL_TRUE);
+    draw_room_depth(vp);
+    draw_objects(world_position.get(), vp, false, 0.0f);
+    glDisable(GL_DEPTH_TEST);
+  }
+};
+
+Renderer::Renderer(const CameraIntrinsics& camera) : impl_(std::make_unique<Impl>()) {
+  if (!camera.is_valid())
+    throw InputError("Renderer: invalid output camera (" + std::to_string(camera.width) + "x" +
+                     std::to_string(camera.height) + ", fx " + std::to_string(camera.fx) +
+                     "); check the camera calibration file");
+  if (!any_context_current())
+    throw RuntimeError("Renderer: no OpenGL context is current; create a gl::Context first");
+  Impl& r = *impl_;
+  r.camera = camera.without_distortion();
+  r.empty_vertex_array = create_vertex_array();
+  using namespace shaders;
+  r.background = create_program("background", kFullscreenVertex, kBackgroundFragment);
+  r.depth_only = create_program("proxy depth", kMeshVertex, kDepthOnlyFragment);
+  r.shaded_object = create_program("shaded object", kMeshVertex,
+                                   (std::string(kShadedObjectFragment) + kIrradianceVolumeGlsl).c_str());
+  r.world_position = create_program("world position", kMeshVertex, kWorldPositionFragment);
+  r.room_radiance = create_program("room radiance", kMeshVertex, kRoomRadianceFragment);
+  r.encode = create_program("sRGB encode", kFullscreenVertex, kEncodeFragment);
+  r.scene = RenderTarget(camera.width, camera.height, GL_RGBA32F, true, "the linear scene");
+  r.encoded = RenderTarget(camera.width, camera.height, GL_RGBA8, false, "the encoded output");
+  check_gl_errors("Renderer::Renderer");
+}
+
+Renderer::~Renderer() = default;
+
+void Renderer::set_room(const Mesh& room_world) {
+  impl_->room = GpuMesh(room_world, "proxy room mesh");
+  check_gl_errors("Renderer::set_room");
+}
+
+void Renderer::set_receivers(const Mesh& receivers_world) {
+  if (receivers_world.indices.empty()) {
+    impl_->receivers.reset();
+    return;
+  }
+  if (!impl_->receivers) impl_->receivers = std::make_unique<ShadowPass>();
+  impl_->receivers->set_receivers(receivers_world);
+}
+
+void Renderer::set_receiver_attenuation(std::span<const glm::vec3> attenuation) {
+  if (!impl_->receivers)
+    throw InputError("Renderer::set_receiver_attenuation: no receivers; call set_receivers first");
+  impl_->receivers->set_attenuation(attenuation);
+}
+
+void Renderer::set_environment(const EnvironmentMap& map) {
+  if (map.width <= 0 || map.height <= 0 || map.rgb.size() != std::size_t(map.width) * map.height * 3)
+    throw InputError("Renderer::set_environment: environment map is empty or its pixel count does not match " +
+                     std::to_string(map.width) + "x" + std::to_string(map.height) + "; load it again");
+  Impl& r = *impl_;
+  r.environment = create_texture_2d(GL_RGB32F, map.width, map.height, GL_LINEAR, GL_REPEAT,
+                                    GL_CLAMP_TO_EDGE);
+  glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+  glPixelStorei(GL_UNPACK_ROW_LENGTH, 0);
+  // Texel row 0 is the map's top row (theta = 0), so v / H is the texture's t directly.
+  glTextureSubImage2D(r.environment.get(), 0, 0, 0, map.width, map.height, GL_RGB, GL_FLOAT, map.rgb.data());
+  r.capture_position = glm::vec3(map.capture_position);
+  // world direction = Ry(offset) * map direction, so map direction = Ry(-offset) * world direction.
+  r.map_from_world = glm::mat3(
+      glm::rotate(glm::dmat4(1.0), glm::radians(-map.azimuth_offset_deg), glm::dvec3(0, 1, 0)));
+  check_gl_errors("Renderer::set_environment");
+}
+
+int Renderer::add_object(const Mesh& mesh_model) {
+  Impl::Object o;
+  o.mesh = GpuMesh(mesh_model, "virtual object mesh");
+  if (mesh_model.normals.empty() && !mesh_model.indices.empty())
+    throw InputError("Renderer::add_object: the virtual object mesh has no normals; load it with load_mesh");
+  o.mesh.set_light_attenuation(std::vector<glm::vec3>(mesh_model.positions.size(), glm::vec3(1.0f)));
+  impl_->objects.push_back(std::move(o));
+  check_gl_errors("Renderer::add_object");
+  return int(impl_->objects.size()) - 1;
+}
+
+void Renderer::set_object_pose(int id, const glm::dmat4& T_world_model) {
+  Impl::Object& o = impl_->object(id, "set_object_pose");
+  o.model = glm::mat4(T_world_model);
+  o.normal_matrix = glm::mat3(glm::transpose(glm::inverse(glm::dmat3(T_world_model))));
+}
+
+void Renderer::set_object_light_attenuation(int id, std::span<const glm::vec3> attenuation) {
+  impl_->object(id, "set_object_light_attenuation").mesh.set_light_attenuation(attenuation);
+  check_gl_errors("Renderer::set_object_light_attenuation");
+}
+
+void Renderer::set_object_material(int id, const glm::vec3& albedo, const SH9& irradiance_sh) {
+  Impl::Object& o = impl_->object(id, "set_object_material");
+  o.albedo = albedo;
+  for (int i = 0; i < 9; ++i) o.sh[std::size_t(i)] = glm::vec3(irradiance_sh.coefficients[std::size_t(i)]);
+}
+
+void Renderer::set_irradiance_volume(const IrradianceVolume* volume) {
+  impl_->volume = volume ? std::make_unique<IrradianceTextures>(*volume) : nullptr;
+  check_gl_errors("Renderer::set_irradiance_volume");
+}
+
+void Renderer::set_undistortion_map(const cv::Mat& map_x, const cv::Mat& map_y) {
+  Impl& r = *impl_;
+  const cv::Size size(r.camera.width, r.camera.height);
+  if (map_x.type() != CV_32FC1 || map_y.type() != CV_32FC1 || map_x.size() != size || map_y.size() != size)
+    throw InputError("Renderer::set_undistortion_map: maps must be CV_32FC1 of the output size " +
+                     std::to_string(size.width) + "x" + std::to_string(size.height) +
+                     "; make them with cv::initUndistortRectifyMap(..., CV_32FC1, ...)");
+  cv::Mat xy;
+  cv::merge(std::vector<cv::Mat>{map_x, map_y}, xy);
+  r.undistortion_map = create_texture_2d(GL_RG32F, size.width, size.height, GL_NEAREST,
+                                         GL_CLAMP_TO_EDGE, GL_CLAMP_TO_EDGE);
+  glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+  glPixelStorei(GL_UNPACK_ROW_LENGTH, 0);
+  glTextureSubImage2D(r.undistortion_map.get(), 0, 0, 0, size.width, size.height, GL_RG, GL_FLOAT, xy.data);
+  check_gl_errors("Renderer::set_undistortion_map");
+}
+
+void Renderer::set_video_radiometry(const VideoRadiometry& radiometry) {
+  Impl& r = *impl_;
+  if (!std::isfinite(radiometry.vignetting_a) || !std::isfinite(radiometry.vignetting_b))
+    throw InputError("Renderer::set_video_radiometry: vignetting coefficients must be finite");
+  r.vignetting = glm::vec2(float(radiometry.vignetting_a), float(radiometry.vignetting_b));
+  r.video_camera = radiometry.video_camera;
+  if (radiometry.linear_of_code.empty()) {
+    r.response_decode = GlName();
+    r.response_encode = GlName();
+    return;
+  }
+  const auto& table = radiometry.linear_of_code;
+  if (table.size() != 3)
+    throw InputError("Renderer::set_video_radiometry: the response needs 3 channels, got " +
+                     std::to_string(table.size()));
+  for (const auto& channel : table)
+    for (int code = 0; code < 256; ++code)
+      if (!std::isfinite(channel[std::size_t(code)]) || channel[std::size_t(code)] < 0.0f ||
+          (code > 0 && channel[std::size_t(code)] < channel[std::size_t(code - 1)]))
+        throw InputError("Renderer::set_video_radiometry: the response is not finite, non-negative and "
+                         "non-decreasing at code " + std::to_string(code) + "; recalibrate it");
+  // Decode: the table itself, RGB order. Encode: its inverse sampled at linear = s^2 * max,
+  // dense near black where codes are closest together in linear terms.
+  constexpr int kEncodeSize = 4096;
+  std::vector<float> decode(256 * 3), encode(kEncodeSize * 3);
+  for (int c = 0; c < 3; ++c) {
+    const auto& lut = table[std::size_t(2 - c)];  // BGR -> RGB
+    r.response_max[c] = std::max(lut[255], 1e-12f);
+    for (int code = 0; code < 256; ++code) decode[std::size_t(code * 3 + c)] = lut[std::size_t(code)];
+    int code = 0;
+    for (int i = 0; i < kEncodeSize; ++i) {
+      const float s = float(i) / float(kEncodeSize - 1), linear = s * s * r.response_max[c];
+      while (code < 254 && lut[std::size_t(code + 1)] < linear) ++code;
+      const float lo = lut[std::size_t(code)], hi = lut[std::size_t(code + 1)];
+      const float f = hi > lo ? std::clamp((linear - lo) / (hi - lo), 0.0f, 1.0f) : (linear >= hi ? 1.0f : 0.0f);
+      encode[std::size_t(i * 3 + c)] = (float(code) + f) / 255.0f;
+    }
+  }
+  r.response_decode = create_texture_2d(GL_RGB32F, 256, 1, GL_LINEAR, GL_CLAMP_TO_EDGE, GL_CLAMP_TO_EDGE);
+  r.response_encode = create_texture_2d(GL_RGB32F, kEncodeSize, 1, GL_LINEAR, GL_CLAMP_TO_EDGE, GL_CLAMP_TO_EDGE);
+  glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+  glPixelStorei(GL_UNPACK_ROW_LENGTH, 0);
+  glTextureSubImage2D(r.response_decode.get(), 0, 0, 0, 256, 1, GL_RGB, GL_FLOAT, decode.data());
+  glTextureSubImage2D(r.response_encode.get(), 0, 0, 0, kEncodeSize, 1, GL_RGB, GL_FLOAT, encode.data());
+  check_gl_errors("Renderer::set_video_radiometry");
+}
+
+cv::Mat Renderer::render_overlay(const cv::Mat& video_bgr8, const std::optional<Pose>& T_world_camera,
+                                 double exposure, OverlayTimings* timings) {
+  if (video_bgr8.type() != CV_8UC3 || video_bgr8.empty())
+    throw InputError("Renderer::render_overlay: video frame must be non-empty BGR8 (CV_8UC3); convert it first");
+  Impl& r = *impl_;
+  OverlayTimings t;
+  StageClock clock(timings != nullptr);
+
+  r.upload_video(video_bgr8);
+  clock.mark(&t.upload_ms);
+
+  // Background: the undistorted video, decoded to linear light.
+  r.scene.begin();
+  glDisable(GL_DEPTH_TEST);
+  glDisable(GL_BLEND);
+  const GLuint bg = r.background.get();
+  glUseProgram(bg);
+  glProgramUniform1i(bg, uniform(bg, "use_undistortion_map"), r.undistortion_map ? 1 : 0);
+  glProgramUniform2f(bg, uniform(bg, "output_size"), float(r.camera.width), float(r.camera.height));
+  glBindTextureUnit(shaders::kVideoUnit, r.video.get());
+  glBindTextureUnit(shaders::kUndistortionMapUnit, r.undistortion_map.get());
+  glProgramUniform1i(bg, uniform(bg, "use_response_lut"), r.response_decode ? 1 : 0);
+  glBindTextureUnit(shaders::kResponseDecodeUnit, r.response_decode.get());
+  r.draw_fullscreen();
+  clock.mark(&t.background_ms);
+
+  // Without a pose there is nothing to place: the video alone, never a guessed object.
+  if (T_world_camera) {
+    const glm::mat4 vp = Impl::view_projection(r.camera, *T_world_camera);
+    glEnable(GL_DEPTH_TEST);
+    glDepthFunc(GL_LESS);
+    glDepthMask(GL_TRUE);
+    r.draw_room_depth(vp);
+    if (r.receivers) r.receivers->draw(vp);  // shadows on the video, before the objects
+    clock.mark(&t.depth_ms);
+
+    // Depth first, then shade only the nearest surface: the per-pixel lighting is the
+    // costly part, and a figurine's own overlapping parts would otherwise pay it twice.
+    glColorMask(GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
+    r.draw_objects(r.depth_only.get(), vp, false, 0.0f);
+    glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+    glDepthFunc(GL_LEQUAL);
+    glDepthMask(GL_FALSE);
+    r.draw_objects(r.shaded_object.get(), vp, true, float(exposure));
+    glDepthMask(GL_TRUE);
+    glDepthFunc(GL_LESS);
+    glDisable(GL_DEPTH_TEST);
+    clock.mark(&t.objects_ms);
+  }
+
+  // Encode to sRGB 8-bit (rows flipped) and read back top row first.
+  r.encoded.begin();
+  const GLuint enc = r.encode.get();
+  glUseProgram(enc);
+  glProgramUniform1i(enc, uniform(enc, "use_response_lut"), r.response_encode ? 1 : 0);
+  glProgramUniform3fv(enc, uniform(enc, "lut_max"), 1, glm::value_ptr(r.response_max));
+  // Without an undistortion map the video is the output camera's image.
+  const bool mapped = bool(r.undistortion_map) && r.video_camera.is_valid();
+  const CameraIntrinsics& vc = mapped ? r.video_camera : r.camera;
+  glProgramUniform1i(enc, uniform(enc, "use_undistortion_map"), mapped ? 1 : 0);
+  glProgramUniform2f(enc, uniform(enc, "principal_point"), float(vc.cx), float(vc.cy));
+  glProgramUniform1f(enc, uniform(enc, "half_diagonal"), 0.5f * std::hypot(float(vc.width), float(vc.height)));
+  glBindTextureUnit(shaders::kUndistortionMapUnit, r.undistortion_map.get());
+  glProgramUniform2fv(enc, uniform(enc, "vignetting"), 1, glm::value_ptr(r.vignetting));
+  glBindTextureUnit(shaders::kLinearImageUnit, r.scene.color.get());
+  glBindTextureUnit(shaders::kResponseEncodeUnit, r.response_encode.get());
+  r.draw_fullscreen();
+  cv::Mat out(r.camera.height, r.camera.width, CV_8UC3);
+  glPixelStorei(GL_PACK_ALIGNMENT, 1);
+  glPixelStorei(GL_PACK_ROW_LENGTH, 0);
+  glReadPixels(0, 0, out.cols, out.rows, GL_BGR, GL_UNSIGNED_BYTE, out.data);
+  clock.mark(&t.readback_ms);
+  check_gl_errors("Renderer::render_overlay");
+  if (timings) *timings = t;
+  return out;
+}
+
+cv::Mat Renderer::render_room_radiance(const CameraIntrinsics& camera, const Pose& T_world_camera) {
+  Impl& r = *impl_;
+  if (!camera.is_valid())
+    throw InputError("Renderer::render_room_radiance: invalid camera (" + std::to_string(camera.width) + "x" +
+                     std::to_string(camera.height) + "); check its intrinsics");
+  if (!r.environment)
+    throw RuntimeError("Renderer::render_room_radiance: no environment map; call set_environment first");
+  if (r.room_target.width != camera.width || r.room_target.height != camera.height)
+    r.room_target = RenderTarget(camera.width, camera.height, GL_RGBA32F, true, "the room radiance");
+
+  const glm::mat4 vp = Impl::view_projection(camera.without_distortion(), T_world_camera);
+  r.room_target.begin();
+  glEnable(GL_DEPTH_TEST);
+  glDepthFunc(GL_LESS);
+  glDepthMask(GL_TRUE);
+  const GLuint p = r.room_radiance.get();
+  glUseProgram(p);
+  Impl::set_transform(p, glm::mat4(1.0f), glm::mat3(1.0f), vp);
+  glProgramUniform3fv(p, uniform(p, "capture_position"), 1, glm::value_ptr(r.capture_position));
+  glProgramUniformMatrix3fv(p, uniform(p, "map_from_world"), 1, GL_FALSE, glm::value_ptr(r.map_from_world));
+  glBindTextureUnit(shaders::kEnvironmentUnit, r.environment.get());
+  r.room.draw();
+  glDisable(GL_DEPTH_TEST);
+
+  return read_float_pixels(camera.width, camera.height, GL_BGR, CV_32FC3, "Renderer::render_room_radiance");
+}
+
+cv::Mat Renderer::render_object_world_positions(const Pose& T_world_camera) {
+  Impl& r = *impl_;
+  r.draw_positions(T_world_camera);
+  return read_float_pixels(r.camera.width, r.camera.height, GL_RGBA, CV_32FC4,
+                           "Renderer::render_object_world_positions");
+}
+
+cv::Mat Renderer::render_object_mask(const Pose& T_world_camera) {
+  cv::Mat w;
+  cv::extractChannel(render_object_world_positions(T_world_camera), w, 3);
+  return w > 0.5f;
+}
+
+}  // namespace lumar::gl

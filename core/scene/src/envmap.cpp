@@ -1,0 +1,135 @@
+#include "lumar/scene/envmap.h"
+
+#include <OpenImageIO/imageio.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "lumar/base/color.h"
+#include "lumar/base/error.h"
+#include "lumar/base/latlong.h"
+
+namespace lumar {
+
+namespace {
+
+// Rotation about +Y, right-handed: Ry(a) maps +Z to (sin a, 0, cos a).
+glm::dvec3 rotate_y(const glm::dvec3& d, double angle_deg) {
+  const double a = glm::radians(angle_deg), c = std::cos(a), s = std::sin(a);
+  return {c * d.x + s * d.z, d.y, -s * d.x + c * d.z};
+}
+
+}  // namespace
+
+glm::dvec3 EnvironmentMap::map_direction(const glm::dvec3& world) const {
+  return rotate_y(world, -azimuth_offset_deg);
+}
+
+glm::dvec3 EnvironmentMap::world_direction(const glm::dvec3& map) const {
+  return rotate_y(map, azimuth_offset_deg);
+}
+
+glm::vec3 EnvironmentMap::radiance(const glm::dvec3& world) const {
+  const glm::dvec2 uv = latlong_coordinates(map_direction(world), width, height);
+  // A zero or non-finite direction has no texel; never index with NaN.
+  if (!std::isfinite(uv.x) || !std::isfinite(uv.y)) return glm::vec3(0.f);
+  // Texel centres sit at +0.5; shift so that integer coordinates are texel centres.
+  const double x = uv.x - 0.5, y = uv.y - 0.5;
+  const double x0 = std::floor(x), y0 = std::floor(y);
+  const double fx = x - x0, fy = y - y0;
+  const auto wrap = [&](long c) { return int(((c % width) + width) % width); };
+  const auto clamp_row = [&](long r) { return int(std::clamp<long>(r, 0, height - 1)); };
+  const int c0 = wrap(long(x0)), c1 = wrap(long(x0) + 1);
+  const int r0 = clamp_row(long(y0)), r1 = clamp_row(long(y0) + 1);
+  const glm::dvec3 top = glm::dvec3(texel(c0, r0)) * (1.0 - fx) + glm::dvec3(texel(c1, r0)) * fx;
+  const glm::dvec3 bottom = glm::dvec3(texel(c0, r1)) * (1.0 - fx) + glm::dvec3(texel(c1, r1)) * fx;
+  return glm::vec3(top * (1.0 - fy) + bottom * fy);
+}
+
+double mean_luminance(const EnvironmentMap& map) {
+  double sum = 0, wsum = 0;
+  for (int r = 0; r < map.height; ++r) {
+    const double w = latlong_pixel_solid_angle(r, map.width, map.height);
+    for (int c = 0; c < map.width; ++c) {
+      sum += w * luminance(map.texel(c, r));
+      wsum += w;
+    }
+  }
+  return wsum > 0 ? sum / wsum : 0.0;
+}
+
+EnvironmentMap load_environment_map(const std::filesystem::path& path) {
+  const std::string name = path.string();
+  if (!std::filesystem::is_regular_file(path))
+    throw InputError(name + ": environment map not found; check the path");
+  auto in = OIIO::ImageInput::open(name);
+  if (!in) {
+    std::string why = OIIO::geterror();
+    std::replace(why.begin(), why.end(), '\n', ' ');
+    throw InputError(name + ": cannot read environment map (" + why +
+                     "); give an OpenEXR or Radiance HDR lat-long image");
+  }
+  const OIIO::ImageSpec& spec = in->spec();
+  const int w = spec.width, h = spec.height, channels = spec.nchannels;
+  if (w <= 0 || h <= 0 || channels <= 0)
+    throw InputError(name + ": environment map has no pixels");
+  if (w != 2 * h)
+    throw InputError(name + ": environment map is " + std::to_string(w) + "x" + std::to_string(h) +
+                     ", but a lat-long map must be twice as wide as high; resample it to 2:1");
+
+  EnvironmentMap map;
+  map.width = w;
+  map.height = h;
+  map.rgb.resize(std::size_t(w) * h * 3);
+  // Colour maps give their first three channels; grey maps (1 or 2 channels) give
+  // channel 0, replicated into R, G and B below.
+  const int read_channels = channels >= 3 ? 3 : 1;
+  std::vector<float> pixels(std::size_t(w) * h * read_channels);
+  if (!in->read_image(0, 0, 0, read_channels, OIIO::TypeDesc::FLOAT, pixels.data())) {
+    std::string why = in->geterror();
+    std::replace(why.begin(), why.end(), '\n', ' ');
+    throw InputError(name + ": cannot read environment map pixels (" + why +
+                     "); the file may be truncated or corrupt");
+  }
+  in->close();
+  for (std::size_t i = 0, n = std::size_t(w) * h; i < n; ++i)
+    for (int k = 0; k < 3; ++k) map.rgb[i * 3 + k] = pixels[i * read_channels + (read_channels == 3 ? k : 0)];
+
+  const auto bad = std::find_if(map.rgb.begin(), map.rgb.end(), [](float v) { return !std::isfinite(v); });
+  if (bad != map.rgb.end()) {
+    const std::size_t pixel = std::size_t(bad - map.rgb.begin()) / 3;
+    throw InputError(name + ": environment map pixel (" + std::to_string(pixel % w) + ", " +
+                     std::to_string(pixel / w) + ") is not finite; repair the map");
+  }
+  return map;
+}
+
+void save_environment_map(const std::filesystem::path& path, const EnvironmentMap& map) {
+  const std::string name = path.string();
+  if (map.width <= 0 || map.height <= 0 || map.rgb.size() != std::size_t(map.width) * map.height * 3)
+    throw RuntimeError(name + ": cannot save an environment map whose pixel buffer does not match its size");
+  // The temporary name does not end in .exr, so name the format explicitly.
+  const std::string tmp = name + ".tmp";
+  auto out = OIIO::ImageOutput::create("openexr");
+  if (!out) throw RuntimeError(name + ": OpenImageIO has no OpenEXR writer (" + OIIO::geterror() + ")");
+  OIIO::ImageSpec spec(map.width, map.height, 3, OIIO::TypeDesc::FLOAT);
+  spec.attribute("compression", "zip");
+  const bool ok = out->open(tmp, spec) &&
+                  out->write_image(OIIO::TypeDesc::FLOAT, map.rgb.data()) && out->close();
+  if (!ok) {
+    std::string why = out->geterror();
+    std::replace(why.begin(), why.end(), '\n', ' ');
+    std::error_code ignored;
+    std::filesystem::remove(tmp, ignored);
+    throw RuntimeError(name + ": cannot write environment map (" + why + "); check the folder and free space");
+  }
+  std::error_code ec;
+  std::filesystem::rename(tmp, path, ec);
+  if (ec) {
+    std::error_code ignored;
+    std::filesystem::remove(tmp, ignored);
+    throw RuntimeError(name + ": cannot write environment map (" + ec.message() + ")");
+  }
+}
+
+}  // namespace lumar

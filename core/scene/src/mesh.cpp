@@ -1,0 +1,134 @@
+#include "lumar/scene/mesh.h"
+
+#include <assimp/postprocess.h>
+#include <assimp/scene.h>
+
+#include <algorithm>
+#include <assimp/Importer.hpp>
+#include <cmath>
+#include <limits>
+
+#include "lumar/base/error.h"
+
+namespace lumar {
+
+namespace {
+
+bool is_finite(const glm::vec3& v) {
+  return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
+}
+
+// Area-weighted vertex normals: the unnormalised cross product of a triangle's edges
+// has length twice its area, so summing them weights each face by its area.
+std::vector<glm::vec3> area_weighted_normals(const std::vector<glm::vec3>& positions,
+                                             const std::vector<std::uint32_t>& indices) {
+  std::vector<glm::dvec3> sum(positions.size(), glm::dvec3(0.0));
+  for (std::size_t t = 0; t + 2 < indices.size(); t += 3) {
+    const glm::dvec3 a = positions[indices[t]], b = positions[indices[t + 1]],
+                     c = positions[indices[t + 2]];
+    const glm::dvec3 n = glm::cross(b - a, c - a);
+    for (int k = 0; k < 3; ++k) sum[indices[t + k]] += n;
+  }
+  std::vector<glm::vec3> normals(positions.size());
+  for (std::size_t i = 0; i < sum.size(); ++i) {
+    const double len = glm::length(sum[i]);
+    // A vertex on no (or only degenerate) triangles has no direction; any unit vector will do.
+    normals[i] = len > 0.0 ? glm::vec3(sum[i] / len) : glm::vec3(0.f, 1.f, 0.f);
+  }
+  return normals;
+}
+
+}  // namespace
+
+std::pair<glm::vec3, glm::vec3> Mesh::bounds() const {
+  if (positions.empty()) return {glm::vec3(0.f), glm::vec3(0.f)};
+  glm::vec3 lo(std::numeric_limits<float>::max()), hi(-std::numeric_limits<float>::max());
+  for (const auto& p : positions) {
+    lo = glm::min(lo, p);
+    hi = glm::max(hi, p);
+  }
+  return {lo, hi};
+}
+
+Mesh load_mesh(const std::filesystem::path& path) {
+  const std::string name = path.string();
+  if (!std::filesystem::is_regular_file(path))
+    throw InputError(name + ": mesh file not found; check the path");
+
+  // Pre-transforming bakes the node hierarchy's transforms into the vertices, so a glTF
+  // or OBJ whose parts are placed by nodes loads where its author put it. Normals are
+  // not generated here: assimp's are not area-weighted, and the file's own are kept.
+  Assimp::Importer importer;
+  const unsigned flags = aiProcess_Triangulate | aiProcess_JoinIdenticalVertices |
+                         aiProcess_PreTransformVertices | aiProcess_SortByPType;
+  const aiScene* scene = importer.ReadFile(name, flags);
+  if (!scene || (scene->mFlags & AI_SCENE_FLAGS_INCOMPLETE) || !scene->mRootNode) {
+    std::string why = importer.GetErrorString();
+    if (why.empty()) why = "incomplete scene";
+    throw InputError(name + ": cannot read mesh (" + why + "); export it as OBJ, PLY or glTF");
+  }
+
+  Mesh mesh;
+  for (unsigned m = 0; m < scene->mNumMeshes; ++m) {
+    const aiMesh* part = scene->mMeshes[m];
+    if (!(part->mPrimitiveTypes & aiPrimitiveType_TRIANGLE)) continue;  // points, lines
+    const auto base = std::uint32_t(mesh.positions.size());
+
+    std::vector<std::uint32_t> part_indices;
+    part_indices.reserve(std::size_t(part->mNumFaces) * 3);
+    for (unsigned f = 0; f < part->mNumFaces; ++f) {
+      const aiFace& face = part->mFaces[f];
+      if (face.mNumIndices != 3) continue;
+      for (int k = 0; k < 3; ++k) part_indices.push_back(face.mIndices[k]);
+    }
+    if (part_indices.empty()) continue;
+
+    std::vector<glm::vec3> part_positions(part->mNumVertices);
+    for (unsigned v = 0; v < part->mNumVertices; ++v) {
+      const aiVector3D& p = part->mVertices[v];
+      part_positions[v] = {p.x, p.y, p.z};
+      if (!is_finite(part_positions[v]))
+        throw InputError(name + ": vertex " + std::to_string(base + v) +
+                         " has a non-finite position; repair the model");
+    }
+
+    // File normals where present and usable; computed ones fill the rest.
+    const std::vector<glm::vec3> computed = area_weighted_normals(part_positions, part_indices);
+    for (unsigned v = 0; v < part->mNumVertices; ++v) {
+      glm::vec3 n = computed[v];
+      if (part->HasNormals()) {
+        const glm::vec3 file_n(part->mNormals[v].x, part->mNormals[v].y, part->mNormals[v].z);
+        const float len = glm::length(file_n);
+        if (std::isfinite(len) && len > 1e-12f) n = file_n / len;
+      }
+      mesh.normals.push_back(n);
+    }
+    mesh.positions.insert(mesh.positions.end(), part_positions.begin(), part_positions.end());
+    for (std::uint32_t i : part_indices) mesh.indices.push_back(base + i);
+  }
+  if (mesh.indices.empty())
+    throw InputError(name + ": mesh holds no triangles; export the model with its faces");
+  return mesh;
+}
+
+Mesh transformed(const Mesh& mesh, const glm::dmat4& m) {
+  Mesh out;
+  out.positions.reserve(mesh.positions.size());
+  out.normals.reserve(mesh.normals.size());
+  for (const auto& p : mesh.positions) {
+    const glm::dvec4 q = m * glm::dvec4(glm::dvec3(p), 1.0);
+    out.positions.emplace_back(glm::dvec3(q) / q.w);
+  }
+  const glm::dmat3 normal_matrix = glm::transpose(glm::inverse(glm::dmat3(m)));
+  for (const auto& n : mesh.normals)
+    out.normals.emplace_back(glm::normalize(normal_matrix * glm::dvec3(n)));
+  out.indices = mesh.indices;
+  // A mirroring transform turns counter-clockwise triangles clockwise; swap two corners
+  // so that the winding still agrees with the (correctly transformed) normals.
+  if (glm::determinant(glm::dmat3(m)) < 0.0)
+    for (std::size_t t = 0; t + 2 < out.indices.size(); t += 3)
+      std::swap(out.indices[t + 1], out.indices[t + 2]);
+  return out;
+}
+
+}  // namespace lumar

@@ -1,0 +1,268 @@
+#include "lumar/scene/scene.h"
+
+#include <cmath>
+#include <fstream>
+#include <glm/gtc/matrix_transform.hpp>
+#include <initializer_list>
+#include <set>
+#include <sstream>
+
+#include "lumar/base/error.h"
+#include "lumar/base/pose.h"
+
+namespace lumar {
+
+namespace {
+
+using nlohmann::json;
+
+// Reads one manifest; every complaint names the manifest and the key path.
+class ManifestReader {
+ public:
+  explicit ManifestReader(std::filesystem::path manifest)
+      : manifest_(std::move(manifest)), folder_(manifest_.parent_path()) {}
+
+  [[noreturn]] void fail(const std::string& key, const std::string& what) const {
+    throw InputError(manifest_.string() + ": " + key + ": " + what);
+  }
+
+  // Rejects keys the format does not define, so that a typo is not silently ignored.
+  void only_keys(const json& object, const std::string& key, std::initializer_list<const char*> known) const {
+    for (const auto& item : object.items()) {
+      bool ok = false;
+      for (const char* k : known) ok = ok || item.key() == k;
+      if (!ok) {
+        std::string list;
+        for (const char* k : known) list += std::string(list.empty() ? "" : ", ") + k;
+        fail(join(key, item.key()), "unknown key (expected one of: " + list + ")");
+      }
+    }
+  }
+
+  static std::string join(const std::string& parent, const std::string& child) {
+    return parent.empty() ? child : parent + "." + child;
+  }
+
+  const json& object(const json& parent, const std::string& parent_key, const char* name) const {
+    const std::string key = join(parent_key, name);
+    if (!parent.contains(name)) fail(key, "missing (see docs/formats.md, \"Scene manifest\")");
+    const json& v = parent.at(name);
+    if (!v.is_object()) fail(key, "expected an object");
+    return v;
+  }
+
+  double number(const json& v, const std::string& key) const {
+    if (!v.is_number()) fail(key, "expected a number");
+    const double d = v.get<double>();
+    if (!std::isfinite(d)) fail(key, "expected a finite number");
+    return d;
+  }
+
+  double number_or(const json& parent, const std::string& parent_key, const char* name, double fallback) const {
+    return parent.contains(name) ? number(parent.at(name), join(parent_key, name)) : fallback;
+  }
+
+  glm::dvec3 vec3(const json& v, const std::string& key, const char* what = "expected 3 numbers") const {
+    if (!v.is_array() || v.size() != 3) fail(key, what);
+    glm::dvec3 out;
+    for (int i = 0; i < 3; ++i) {
+      if (!v[i].is_number() || !std::isfinite(v[i].get<double>())) fail(key, what);
+      out[i] = v[i].get<double>();
+    }
+    return out;
+  }
+
+  glm::dvec3 vec3_or(const json& parent, const std::string& parent_key, const char* name, glm::dvec3 fallback) const {
+    return parent.contains(name) ? vec3(parent.at(name), join(parent_key, name)) : fallback;
+  }
+
+  bool boolean_or(const json& parent, const std::string& parent_key, const char* name, bool fallback) const {
+    if (!parent.contains(name)) return fallback;
+    if (!parent.at(name).is_boolean()) fail(join(parent_key, name), "expected true or false");
+    return parent.at(name).get<bool>();
+  }
+
+  std::string string(const json& parent, const std::string& parent_key, const char* name) const {
+    const std::string key = join(parent_key, name);
+    if (!parent.contains(name)) fail(key, "missing");
+    const json& v = parent.at(name);
+    if (!v.is_string() || v.get<std::string>().empty()) fail(key, "expected a non-empty string");
+    return v.get<std::string>();
+  }
+
+  // A path relative to the manifest's folder; the file must exist.
+  std::filesystem::path existing_file(const json& parent, const std::string& parent_key, const char* name) const {
+    const std::filesystem::path given = string(parent, parent_key, name);
+    const std::filesystem::path resolved = (folder_ / given).lexically_normal();
+    if (!std::filesystem::is_regular_file(resolved))
+      fail(join(parent_key, name), "file not found: " + resolved.string());
+    return resolved;
+  }
+
+ private:
+  std::filesystem::path manifest_;
+  std::filesystem::path folder_;
+};
+
+json parse_manifest(const std::filesystem::path& manifest) {
+  const std::string name = manifest.string();
+  if (!std::filesystem::is_regular_file(manifest))
+    throw InputError(name + ": scene manifest not found; check the path");
+  std::ifstream file(manifest, std::ios::binary);
+  if (!file) throw InputError(name + ": cannot open the scene manifest for reading");
+  std::stringstream text;
+  text << file.rdbuf();
+  try {
+    return json::parse(text.str());
+  } catch (const json::parse_error& e) {
+    // e.what() starts with "[json.exception.parse_error.101] "; the rest says where.
+    std::string why = e.what();
+    if (const auto p = why.find("] "); p != std::string::npos) why = why.substr(p + 2);
+    throw InputError(name + ": malformed JSON: " + why);
+  }
+}
+
+SceneObject read_object(const ManifestReader& r, const json& v, const std::string& key) {
+  if (!v.is_object()) r.fail(key, "expected an object");
+  r.only_keys(v, key, {"name", "mesh", "albedo", "pose"});
+  SceneObject object;
+  object.name = r.string(v, key, "name");
+  object.mesh = r.existing_file(v, key, "mesh");
+  if (v.contains("albedo")) {
+    const char* what = "expected 3 numbers in [0, 1]";
+    const glm::dvec3 a = r.vec3(v.at("albedo"), key + ".albedo", what);
+    for (int i = 0; i < 3; ++i)
+      if (a[i] < 0.0 || a[i] > 1.0) r.fail(key + ".albedo", what);
+    object.albedo = glm::vec3(a);
+  }
+
+  glm::dvec3 translation(0.0), axis(0.0, 1.0, 0.0), model_origin(0.0);
+  double angle_deg = 0.0, scale = 1.0;
+  if (v.contains("pose")) {
+    const json& pose = r.object(v, key, "pose");
+    const std::string pk = key + ".pose";
+    r.only_keys(pose, pk, {"translation", "rotation_axis", "rotation_deg", "scale", "model_origin"});
+    translation = r.vec3_or(pose, pk, "translation", translation);
+    axis = r.vec3_or(pose, pk, "rotation_axis", axis);
+    angle_deg = r.number_or(pose, pk, "rotation_deg", 0.0);
+    scale = r.number_or(pose, pk, "scale", 1.0);
+    model_origin = r.vec3_or(pose, pk, "model_origin", model_origin);
+    if (glm::length(axis) < 1e-9) r.fail(pk + ".rotation_axis", "must not be the zero vector");
+    if (!(scale > 0.0)) r.fail(pk + ".scale", "must be positive");
+  }
+  const glm::dmat4 rotate = glm::mat4_cast(axis_angle_deg(axis, angle_deg));
+  object.T_world_model = glm::translate(glm::dmat4(1.0), translation) * rotate *
+                         glm::scale(glm::dmat4(1.0), glm::dvec3(scale)) *
+                         glm::translate(glm::dmat4(1.0), -model_origin);
+  return object;
+}
+
+std::vector<SceneBox> read_boxes(const ManifestReader& r, const json& parent, const std::string& parent_key,
+                                 const char* name) {
+  std::vector<SceneBox> boxes;
+  if (!parent.contains(name)) return boxes;
+  const std::string key = ManifestReader::join(parent_key, name);
+  const json& list = parent.at(name);
+  if (!list.is_array()) r.fail(key, "expected an array of {\"min\": [x, y, z], \"max\": [x, y, z]} boxes");
+  for (std::size_t i = 0; i < list.size(); ++i) {
+    const std::string k = key + "[" + std::to_string(i) + "]";
+    if (!list[i].is_object()) r.fail(k, "expected an object with min and max");
+    r.only_keys(list[i], k, {"min", "max"});
+    if (!list[i].contains("min")) r.fail(k + ".min", "missing");
+    if (!list[i].contains("max")) r.fail(k + ".max", "missing");
+    SceneBox b{r.vec3(list[i].at("min"), k + ".min"), r.vec3(list[i].at("max"), k + ".max")};
+    for (int a = 0; a < 3; ++a)
+      if (b.min[a] > b.max[a]) r.fail(k, "min must not exceed max on any axis");
+    boxes.push_back(b);
+  }
+  return boxes;
+}
+
+ShadowRegions read_shadows(const ManifestReader& r, const json& doc) {
+  ShadowRegions out;
+  if (!doc.contains("shadows")) return out;
+  const json& v = r.object(doc, "", "shadows");
+  r.only_keys(v, "shadows", {"receivers", "emitters", "receiver_vertices"});
+  out.receivers = read_boxes(r, v, "shadows", "receivers");
+  out.emitters = read_boxes(r, v, "shadows", "emitters");
+  if (v.contains("receiver_vertices")) {
+    const json& n = v.at("receiver_vertices");
+    if (!n.is_number_integer() || n.get<long long>() < 4 || n.get<long long>() > 1000000)
+      r.fail("shadows.receiver_vertices", "expected an integer from 4 to 1000000");
+    out.receiver_vertices = int(n.get<long long>());
+  }
+  return out;
+}
+
+}  // namespace
+
+Scene load_scene(const std::filesystem::path& manifest) {
+  const json doc = parse_manifest(manifest);
+  const ManifestReader r(manifest);
+  if (!doc.is_object()) r.fail("(top level)", "expected a JSON object");
+  r.only_keys(doc, "", {"format", "version", "room", "environment_map", "movement_box", "objects", "lighting",
+                      "shadows"});
+
+  if (!doc.contains("format") || doc.at("format") != "lumar-scene")
+    r.fail("format", "expected \"lumar-scene\"");
+  if (!doc.contains("version") || !doc.at("version").is_number_integer())
+    r.fail("version", "expected an integer");
+  if (doc.at("version").get<long long>() != 1)
+    r.fail("version", "this build reads version 1; update lumar or convert the manifest");
+
+  Scene scene;
+  scene.manifest = manifest;
+
+  const json& env = r.object(doc, "", "environment_map");
+  r.only_keys(env, "environment_map", {"path", "capture_position", "azimuth_offset_deg", "distant"});
+  scene.environment_map = r.existing_file(env, "environment_map", "path");
+  scene.distant_map = r.boolean_or(env, "environment_map", "distant", false);
+  scene.azimuth_offset_deg = r.number_or(env, "environment_map", "azimuth_offset_deg", 0.0);
+  // A distant map is at infinity, so where it was captured does not matter.
+  if (!scene.distant_map && !env.contains("capture_position"))
+    r.fail("environment_map.capture_position", "missing (required unless \"distant\": true)");
+  scene.capture_position = r.vec3_or(env, "environment_map", "capture_position", glm::dvec3(0.0));
+
+  // The proxy room gives the map's parallax and the surfaces shadows fall on; only a
+  // distant map can do without it.
+  if (doc.contains("room")) {
+    const json& room = r.object(doc, "", "room");
+    r.only_keys(room, "room", {"mesh", "scale"});
+    scene.room_mesh = r.existing_file(room, "room", "mesh");
+    scene.room_scale = r.number_or(room, "room", "scale", 1.0);
+    if (!(scene.room_scale > 0.0)) r.fail("room.scale", "must be positive");
+  } else if (!scene.distant_map) {
+    r.fail("room", "missing (required unless environment_map.distant is true)");
+  }
+
+  const json& box = r.object(doc, "", "movement_box");
+  r.only_keys(box, "movement_box", {"min", "max"});
+  if (!box.contains("min")) r.fail("movement_box.min", "missing");
+  if (!box.contains("max")) r.fail("movement_box.max", "missing");
+  scene.movement_min = r.vec3(box.at("min"), "movement_box.min");
+  scene.movement_max = r.vec3(box.at("max"), "movement_box.max");
+  for (int i = 0; i < 3; ++i)
+    if (scene.movement_min[i] > scene.movement_max[i])
+      r.fail("movement_box", "min must not exceed max on any axis");
+
+  if (doc.contains("objects")) {
+    const json& objects = doc.at("objects");
+    if (!objects.is_array()) r.fail("objects", "expected an array");
+    std::set<std::string> names;
+    for (std::size_t i = 0; i < objects.size(); ++i) {
+      const std::string key = "objects[" + std::to_string(i) + "]";
+      scene.objects.push_back(read_object(r, objects[i], key));
+      if (!names.insert(scene.objects.back().name).second)
+        r.fail(key + ".name", "\"" + scene.objects.back().name + "\" is used by an earlier object");
+    }
+  }
+
+  if (doc.contains("lighting")) {
+    if (!doc.at("lighting").is_object()) r.fail("lighting", "expected an object");
+    scene.lighting = doc.at("lighting");
+  }
+  scene.shadows = read_shadows(r, doc);
+  return scene;
+}
+
+}  // namespace lumar
