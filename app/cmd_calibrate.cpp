@@ -1,18 +1,18 @@
 // lumar calibrate: camera intrinsics from views of a checkerboard or a ChArUco board.
+#include <spdlog/spdlog.h>
 #include <algorithm>
 #include <cstdio>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <opencv2/core/utility.hpp>
-#include <spdlog/spdlog.h>
 
 #include "commands.h"
+#include "lumar/base/error.h"
 #include "lumar/calib/calibration_report.h"
 #include "lumar/calib/charuco_calibration.h"
 #include "lumar/calib/checkerboard_calibration.h"
 #include "lumar/calib/video_views.h"
 #include "lumar/capture/source_spec.h"
-#include "lumar/base/error.h"
 
 namespace lumar::app {
 
@@ -67,8 +67,8 @@ std::vector<calib::NamedImage> frames_from_source(const CalibrateOptions& o) {
   options.fps = 30.0;  // an image sequence's timing does not matter here
   auto opened = capture::open_frame_source(o.source, options);
   if (opened.live)
-    spdlog::info("calibrate: taking every {}th frame of {} until {} views; move the board around the image",
-                 o.every, o.source, o.max_frames);
+    spdlog::info("calibrate: taking every {}th frame of {} until {} views; move the board around the image", o.every,
+                 o.source, o.max_frames);
   return calib::sample_frames(*opened.source, o.every, o.max_frames);
 }
 
@@ -76,15 +76,21 @@ std::vector<calib::NamedImage> frames_from_source(const CalibrateOptions& o) {
 
 void register_calibrate(CLI::App& app) {
   auto o = std::make_shared<CalibrateOptions>();
-  auto* cmd = app.add_subcommand("calibrate", "Calibrate camera intrinsics from views of a checkerboard or ChArUco board");
+  auto* cmd =
+      app.add_subcommand("calibrate", "Calibrate camera intrinsics from views of a checkerboard or ChArUco board");
   cmd->add_option("--images", o->images, "Image files or glob patterns (quote globs)");
   cmd->add_option("--video", o->video, "A video file of the board instead of --images (as --source video:FILE)");
-  cmd->add_option("--source", o->source,
-                  "Frames instead of --images: video:FILE, images:GLOB, recording:DIR or a live camera v4l2:/dev/videoN");
-  cmd->add_option("--every", o->every, "--video/--source: use every Nth frame")->check(CLI::PositiveNumber)->capture_default_str();
+  cmd->add_option(
+      "--source", o->source,
+      "Frames instead of --images: video:FILE, images:GLOB, recording:DIR or a live camera v4l2:/dev/videoN");
+  cmd->add_option("--every", o->every, "--video/--source: use every Nth frame")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
   cmd->add_option("--max-views", o->max_frames, "--video/--source: stop after this many sampled frames")
-      ->check(CLI::PositiveNumber)->capture_default_str();
-  cmd->add_option("--charuco", o->charuco, "A ChArUco board of SQUARESxSQUARES (squares, not corners) instead of --board");
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  cmd->add_option("--charuco", o->charuco,
+                  "A ChArUco board of SQUARESxSQUARES (squares, not corners) instead of --board");
   cmd->add_option("--marker", o->marker, "--charuco: marker side in metres")->check(CLI::PositiveNumber);
   cmd->add_option("--dict", o->dict, "--charuco: ArUco dictionary")->capture_default_str();
   cmd->add_option("--board", o->board, "Inner corners of the board, WxH")->capture_default_str();
@@ -125,7 +131,8 @@ void register_calibrate(CLI::App& app) {
     const auto& c = result.camera.intrinsics;
     if (o->json) {
       nlohmann::json std_dev = nlohmann::json::object();
-      for (std::size_t i = 0; i < calib::kIntrinsicNames.size(); ++i) std_dev[calib::kIntrinsicNames[i]] = result.std_dev[i];
+      for (std::size_t i = 0; i < calib::kIntrinsicNames.size(); ++i)
+        std_dev[calib::kIntrinsicNames[i]] = result.std_dev[i];
       nlohmann::json rejected = nlohmann::json::array(), rejections = nlohmann::json::array();
       for (const auto& v : result.rejected) {
         rejected.push_back(v.name);
@@ -133,16 +140,23 @@ void register_calibrate(CLI::App& app) {
       }
       nlohmann::json j = {{"rms", result.camera.avg_reprojection_error},
                           {"initial_rms", result.initial_rms},
-                          {"fx", c.fx}, {"fy", c.fy}, {"cx", c.cx}, {"cy", c.cy},
-                          {"dist", c.distortion}, {"std", std_dev},
+                          {"fx", c.fx},
+                          {"fy", c.fy},
+                          {"cx", c.cx},
+                          {"cy", c.cy},
+                          {"dist", c.distortion},
+                          {"std", std_dev},
                           {"views_used", result.used_views.size()},
                           {"used_views", result.used_views},
-                          {"views_rejected", rejected}, {"rejections", rejections},
+                          {"views_rejected", rejected},
+                          {"rejections", rejections},
                           {"views_without_board", result.views_without_board},
                           {"per_view_rms", result.per_view_rms},
-                          {"holdout_rms", result.holdout_rms}, {"holdout_training_rms", result.training_rms},
+                          {"holdout_rms", result.holdout_rms},
+                          {"holdout_training_rms", result.training_rms},
                           {"holdout_splits", result.holdout_splits},
-                          {"coverage", result.coverage}, {"orientations", result.orientations},
+                          {"coverage", result.coverage},
+                          {"orientations", result.orientations},
                           {"warnings", result.warnings}};
       std::printf("%s\n", j.dump(2).c_str());
     } else {
@@ -151,13 +165,14 @@ void register_calibrate(CLI::App& app) {
                    result.initial_rms, o->out);
       spdlog::info("  fx {:.2f} ± {:.2f}  fy {:.2f} ± {:.2f}  cx {:.2f} ± {:.2f}  cy {:.2f} ± {:.2f}", c.fx,
                    result.std_dev[0], c.fy, result.std_dev[1], c.cx, result.std_dev[2], c.cy, result.std_dev[3]);
-      spdlog::info("  k1 {:.4f} ± {:.4f}  k2 {:.4f} ± {:.4f}  p1 {:.5f} ± {:.5f}  p2 {:.5f} ± {:.5f}  k3 {:.4f} ± {:.4f}",
-                   c.distortion[0], result.std_dev[4], c.distortion[1], result.std_dev[5], c.distortion[2],
-                   result.std_dev[6], c.distortion[3], result.std_dev[7], c.distortion[4], result.std_dev[8]);
-      spdlog::info("  held-out RMS {:.3f} px over {} half/half splits (training halves {:.3f} px); coverage {:.0f}%, "
-                   "{} board orientations",
-                   result.holdout_rms, result.holdout_splits, result.training_rms, 100 * result.coverage,
-                   result.orientations);
+      spdlog::info(
+          "  k1 {:.4f} ± {:.4f}  k2 {:.4f} ± {:.4f}  p1 {:.5f} ± {:.5f}  p2 {:.5f} ± {:.5f}  k3 {:.4f} ± {:.4f}",
+          c.distortion[0], result.std_dev[4], c.distortion[1], result.std_dev[5], c.distortion[2], result.std_dev[6],
+          c.distortion[3], result.std_dev[7], c.distortion[4], result.std_dev[8]);
+      spdlog::info(
+          "  held-out RMS {:.3f} px over {} half/half splits (training halves {:.3f} px); coverage {:.0f}%, "
+          "{} board orientations",
+          result.holdout_rms, result.holdout_splits, result.training_rms, 100 * result.coverage, result.orientations);
       for (const auto& v : result.rejected)
         spdlog::info("  rejected {}: {:.3f} px > threshold {:.3f} px (round {})", v.name, v.rms_px, v.threshold_px,
                      v.round);

@@ -1,15 +1,15 @@
 // lumar calibrate-rig: tracker-to-camera offset, transmitter alignment and latency from a
 // recording of the tracked camera filming a checkerboard; written into its session.json.
+#include <spdlog/spdlog.h>
 #include <cstdio>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <optional>
-#include <spdlog/spdlog.h>
 
 #include "commands.h"
+#include "lumar/base/error.h"
 #include "lumar/calib/camera_file.h"
 #include "lumar/calib/rig_recording.h"
-#include "lumar/base/error.h"
 
 namespace lumar::app {
 
@@ -52,12 +52,15 @@ void register_calibrate_rig(CLI::App& app) {
   cmd->add_option("--camera", o->camera, "Camera calibration (OpenCV YAML); default: the session's camera");
   cmd->add_option("--every", o->every, "Use every Nth frame")->check(CLI::PositiveNumber)->capture_default_str();
   cmd->add_option("--max-offset-ms", o->max_offset_ms, "Search the tracker-video time offset within +- this")
-      ->check(CLI::PositiveNumber)->capture_default_str();
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
   cmd->add_flag("--fixed-latency", o->fixed_latency, "Keep the session's latency (do not estimate the time offset)");
   cmd->add_option("--tracker-rotation-sigma-deg", o->calib.tracker_rotation_sigma_deg,
-                  "Tracker orientation noise, RMS degrees (weights the fit)")->capture_default_str();
+                  "Tracker orientation noise, RMS degrees (weights the fit)")
+      ->capture_default_str();
   cmd->add_option("--tracker-position-sigma-m", o->calib.tracker_position_sigma_m,
-                  "Tracker position noise, RMS metres per axis (weights the fit)")->capture_default_str();
+                  "Tracker position noise, RMS metres per axis (weights the fit)")
+      ->capture_default_str();
   cmd->add_flag("--dry-run", o->dry_run, "Report only; leave session.json as it is");
   cmd->add_flag("--json", o->json, "Print a machine-readable summary to stdout");
   add_action(cmd, [o] {
@@ -70,7 +73,8 @@ void register_calibrate_rig(CLI::App& app) {
     options.time_offset.max_offset = seconds_to_nanos(o->max_offset_ms * 1e-3);
     calib::RigCalibrationResult result;
     try {
-      result = calib::calibrate_rig(rec.views, rec.tracker, rec.session.tracker.station, rec.session.rig.latency, options);
+      result =
+          calib::calibrate_rig(rec.views, rec.tracker, rec.session.tracker.station, rec.session.rig.latency, options);
     } catch (const InputError& e) {
       throw InputError(o->recording + ": " + e.what());
     }
@@ -87,27 +91,30 @@ void register_calibrate_rig(CLI::App& app) {
     }
     const auto& x = result.rig.T_sensor_camera;
     const auto& w = result.rig.T_world_transmitter;
-    spdlog::info("calibrate-rig: board in {} of {} frames; {} views used ({} rejected for PnP error > {:.2f} px); "
-                 "{} tracker samples fitted ({} rejected by the fit); camera turned {:.0f} deg",
-                 rec.views.size(), rec.frames, result.views_used, result.views_rejected_pnp,
-                 result.view_rms_threshold_px, result.samples_used, result.samples_rejected_residual,
-                 result.rotation_range_deg);
-    spdlog::info("  latency {:.2f} ms (assumed {:.2f} ms; offset {:+.2f} ms +- {:.2f}, cross-correlation {:+.2f} ms, "
-                 "peak r = {:.3f}, r at 0 = {:.3f})",
-                 nanos_to_seconds(result.rig.latency) * 1e3, nanos_to_seconds(result.assumed_latency) * 1e3,
-                 nanos_to_seconds(result.time_offset) * 1e3, result.sigma_time_offset_s * 1e3,
-                 nanos_to_seconds(result.correlation_offset) * 1e3, result.peak_correlation, result.correlation_at_zero);
+    spdlog::info(
+        "calibrate-rig: board in {} of {} frames; {} views used ({} rejected for PnP error > {:.2f} px); "
+        "{} tracker samples fitted ({} rejected by the fit); camera turned {:.0f} deg",
+        rec.views.size(), rec.frames, result.views_used, result.views_rejected_pnp, result.view_rms_threshold_px,
+        result.samples_used, result.samples_rejected_residual, result.rotation_range_deg);
+    spdlog::info(
+        "  latency {:.2f} ms (assumed {:.2f} ms; offset {:+.2f} ms +- {:.2f}, cross-correlation {:+.2f} ms, "
+        "peak r = {:.3f}, r at 0 = {:.3f})",
+        nanos_to_seconds(result.rig.latency) * 1e3, nanos_to_seconds(result.assumed_latency) * 1e3,
+        nanos_to_seconds(result.time_offset) * 1e3, result.sigma_time_offset_s * 1e3,
+        nanos_to_seconds(result.correlation_offset) * 1e3, result.peak_correlation, result.correlation_at_zero);
     spdlog::info("  T_sensor_camera: t = ({:.4f}, {:.4f}, {:.4f}) m +- {:.2f} mm, rotation {:.2f} deg +- {:.3f} deg",
                  x.translation.x, x.translation.y, x.translation.z, result.sigma_translation_m * 1e3, deg(x.rotation),
                  result.sigma_rotation_deg);
-    spdlog::info("  T_world_transmitter: t = ({:.4f}, {:.4f}, {:.4f}) m, rotation {:.2f} deg (world = board frame, "
-                 "+Y out of its face)",
-                 w.translation.x, w.translation.y, w.translation.z, deg(w.rotation));
-    spdlog::info("  residuals: {:.3f} deg, {:.2f} mm RMS (tracker against board); cv::calibrateHandEye alone differs "
-                 "by {:.2f} mm, {:.3f} deg",
-                 result.rotation_rms_deg, result.translation_rms_m * 1e3,
-                 1e3 * glm::length(result.hand_eye.T_sensor_camera.translation - x.translation),
-                 rotation_angle_deg(result.hand_eye.T_sensor_camera.rotation, x.rotation));
+    spdlog::info(
+        "  T_world_transmitter: t = ({:.4f}, {:.4f}, {:.4f}) m, rotation {:.2f} deg (world = board frame, "
+        "+Y out of its face)",
+        w.translation.x, w.translation.y, w.translation.z, deg(w.rotation));
+    spdlog::info(
+        "  residuals: {:.3f} deg, {:.2f} mm RMS (tracker against board); cv::calibrateHandEye alone differs "
+        "by {:.2f} mm, {:.3f} deg",
+        result.rotation_rms_deg, result.translation_rms_m * 1e3,
+        1e3 * glm::length(result.hand_eye.T_sensor_camera.translation - x.translation),
+        rotation_angle_deg(result.hand_eye.T_sensor_camera.rotation, x.rotation));
     spdlog::info("  {} {}", o->dry_run ? "dry run, not written to" : "written to", o->recording + "/session.json");
   });
 }

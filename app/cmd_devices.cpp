@@ -47,14 +47,16 @@ void run_devices() {
   }
 
   if (inv.polhemus.empty() && inv.usb_serial.empty())
-    std::printf("No tracker hardware found. An ISOTRAK II is RS-232 only: connect it to a serial port or a "
-                "USB-serial adapter. To try the software without one: lumar tracker emulate --link /tmp/isotrak\n");
+    std::printf(
+        "No tracker hardware found. An ISOTRAK II is RS-232 only: connect it to a serial port or a "
+        "USB-serial adapter. To try the software without one: lumar tracker emulate --link /tmp/isotrak\n");
 }
 
 }  // namespace
 
 void register_devices(CLI::App& app) {
-  auto* cmd = app.add_subcommand("devices", "List serial ports, Polhemus USB devices, USB-serial adapters and V4L2 cameras");
+  auto* cmd =
+      app.add_subcommand("devices", "List serial ports, Polhemus USB devices, USB-serial adapters and V4L2 cameras");
   add_action(cmd, [] { run_devices(); });
 }
 

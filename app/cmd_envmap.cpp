@@ -5,13 +5,13 @@
 #include <memory>
 
 #include "commands.h"
-#include "lumar/pipeline/envmap_images.h"
-#include "lumar/pipeline/envmap_live.h"
-#include "lumar/pipeline/envmap_sweep.h"
+#include "lumar/base/error.h"
 #include "lumar/calib/camera_file.h"
 #include "lumar/calib/camera_response.h"
 #include "lumar/capture/recording_replay.h"
-#include "lumar/base/error.h"
+#include "lumar/pipeline/envmap_images.h"
+#include "lumar/pipeline/envmap_live.h"
+#include "lumar/pipeline/envmap_sweep.h"
 
 namespace lumar::app {
 
@@ -69,7 +69,8 @@ SweepInput recording_sweep_input(const std::string& recording, const std::string
   in.label_header = "index,time_ns";
 
   std::vector<double> exposures{session.radiometry.exposure};
-  if (session.extra.contains("frame_exposures")) exposures = session.extra["frame_exposures"].get<std::vector<double>>();
+  if (session.extra.contains("frame_exposures"))
+    exposures = session.extra["frame_exposures"].get<std::vector<double>>();
   for (double e : exposures)
     if (!(e > 0) || !std::isfinite(e))
       throw InputError((dir / capture::kSessionFile).string() + ": exposures must be positive numbers");
@@ -161,7 +162,8 @@ void register_envmap(CLI::App& app) {
   cmd->add_option("--images", o->images.images, "Folder or glob of the sweep's images (with --poses and --camera)");
   cmd->add_option("--poses", o->images.poses, "--images: CSV file,qw,qx,qy,qz[,x,y,z][,exposure][,station]");
   cmd->add_option("--response", o->images.response, "--images, --source: camera response JSON (default: sRGB)");
-  cmd->add_option("--vignetting", o->images.vignetting_a, "--images, --source: vignetting gain 1 + a r^2 + b r^4, the a term");
+  cmd->add_option("--vignetting", o->images.vignetting_a,
+                  "--images, --source: vignetting gain 1 + a r^2 + b r^4, the a term");
   cmd->add_option("--vignetting-b", o->images.vignetting_b, "--images, --source: vignetting, the b term");
   cmd->add_option("--tracker-noise-deg", o->images.tracker_noise_deg,
                   "--images, --source: RMS error of the poses' rotations (the refinement's prior)")

@@ -105,7 +105,8 @@ void write_results(const std::string& path, const std::vector<glm::dvec3>& e) {
 }
 
 void run(const IrradianceOptions& o) {
-  if (o.scene.empty() == o.envmap.empty()) throw InputError("lumar irradiance: give either --scene S or --envmap MAP.exr");
+  if (o.scene.empty() == o.envmap.empty())
+    throw InputError("lumar irradiance: give either --scene S or --envmap MAP.exr");
   const Query q = read_queries(o.query);
   std::unique_ptr<Scene> scene;
   std::string method = o.method;
@@ -122,9 +123,12 @@ void run(const IrradianceOptions& o) {
     } else {
       e = texel_sum_irradiance(load_environment_map(o.envmap), q.normals);
     }
-    if (radiance && radiance->distant()) e = texel_sum_irradiance(radiance->working_map(), q.normals);
-    else if (radiance) e = reference_irradiance(*radiance, q.points, q.normals, o.strata);
-    if (radiance) spdlog::info("reference: {} rays, {} used the fallback", radiance->traced_rays(), radiance->fallback_rays());
+    if (radiance && radiance->distant())
+      e = texel_sum_irradiance(radiance->working_map(), q.normals);
+    else if (radiance)
+      e = reference_irradiance(*radiance, q.points, q.normals, o.strata);
+    if (radiance)
+      spdlog::info("reference: {} rays, {} used the fallback", radiance->traced_rays(), radiance->fallback_rays());
   } else {
     Scene distant;
     if (!scene) {
@@ -140,10 +144,11 @@ void run(const IrradianceOptions& o) {
         o.no_cache ? IrradianceVolume::build(*radiance, s.movement_min, s.movement_max, settings)
                    : cached_irradiance_volume(*radiance, s.movement_min, s.movement_max, settings, o.cache, &loaded);
     const auto& st = volume.stats();
-    spdlog::info("irradiance volume ({}): {} {} probes ({} moved, {} disabled), {} cells ({} refined), {:.0f} ms, "
-                 "{} rays, {} fallback",
-                 settings.describe(), loaded ? "loaded" : "built", st.probes, st.moved, st.disabled, st.cells,
-                 st.refined_cells, st.build_ms, st.rays, st.fallback_rays);
+    spdlog::info(
+        "irradiance volume ({}): {} {} probes ({} moved, {} disabled), {} cells ({} refined), {:.0f} ms, "
+        "{} rays, {} fallback",
+        settings.describe(), loaded ? "loaded" : "built", st.probes, st.moved, st.disabled, st.cells, st.refined_cells,
+        st.build_ms, st.rays, st.fallback_rays);
     for (std::size_t i = 0; i < q.points.size(); ++i) e.push_back(volume.evaluate(q.points[i], q.normals[i]));
   }
   write_results(o.out, e);

@@ -1,12 +1,12 @@
 // lumar overlay: composite the scene's virtual objects into a recording's video.
+#include <spdlog/spdlog.h>
 #include <memory>
 #include <optional>
-#include <spdlog/spdlog.h>
 
 #include "commands.h"
 #include "lumar/base/error.h"
-#include "lumar/pipeline/output_files.h"
 #include "lumar/pipeline/live_overlay.h"
+#include "lumar/pipeline/output_files.h"
 #include "lumar/pipeline/replay_overlay.h"
 
 namespace lumar::app {
@@ -22,7 +22,8 @@ struct OverlayOptions {
 
 void register_overlay(CLI::App& app) {
   auto o = std::make_shared<OverlayOptions>();
-  auto* cmd = app.add_subcommand("overlay", "Composite virtual objects into a recording's video (headless or in a window)");
+  auto* cmd =
+      app.add_subcommand("overlay", "Composite virtual objects into a recording's video (headless or in a window)");
   cmd->add_option("--recording", o->recording, "Recording directory (video + tracker stream + session.json)");
   // The live path (live_overlay.h): --source and --tracker instead of --recording.
   auto live = std::make_shared<LiveOverlayOptions>();
@@ -34,13 +35,18 @@ void register_overlay(CLI::App& app) {
   cmd->add_option("--frames-dir", o->frames_dir, "Also write every output frame as PNG into this new folder");
   cmd->add_option("--contact-sheet", o->contact_sheet, "Also write 8 frames spread over the run, tiled, as one PNG");
   cmd->add_option("--poses", o->poses, "Camera poses from the tracker stream or from the recording's ground truth")
-      ->check(CLI::IsMember({"tracker", "truth"}))->capture_default_str();
-  cmd->add_option("--undistort", o->undistort,
-                  "Output camera: 'same' keeps the calibrated matrix, 'crop' shows only valid pixels, 'keep' every input pixel")
-      ->check(CLI::IsMember({"same", "crop", "keep"}))->capture_default_str();
-  cmd->add_option("--adapt-lighting", o->adapt_lighting,
-                  "Every N frames, compare the video with the map and follow the room getting brighter or darker (0 = off)")
-      ->check(CLI::NonNegativeNumber)->capture_default_str();
+      ->check(CLI::IsMember({"tracker", "truth"}))
+      ->capture_default_str();
+  cmd->add_option(
+         "--undistort", o->undistort,
+         "Output camera: 'same' keeps the calibrated matrix, 'crop' shows only valid pixels, 'keep' every input pixel")
+      ->check(CLI::IsMember({"same", "crop", "keep"}))
+      ->capture_default_str();
+  cmd->add_option(
+         "--adapt-lighting", o->adapt_lighting,
+         "Every N frames, compare the video with the map and follow the room getting brighter or darker (0 = off)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
   cmd->add_flag("--window", o->window, "Show the result in a window (needs a display)");
   cmd->add_option("--max-frames", o->max_frames, "Stop after this many frames (0 = all)")->capture_default_str();
   add_action(cmd, [o, live] {
@@ -88,9 +94,9 @@ void register_overlay(CLI::App& app) {
     if (frames) frames->commit();
     if (!o->contact_sheet.empty()) write_contact_sheet(o->contact_sheet, sheet);
     const auto& stats = overlay.replay().tracker_stats();
-    spdlog::info("overlay: {} frames{}{}; tracker: {} records, {} rejected, {} bytes skipped",
-                 overlay.times().frames, o->out.empty() ? "" : " -> " + o->out,
-                 video ? " (" + video->codec() + ")" : "", stats.records, stats.rejected_records, stats.skipped_bytes);
+    spdlog::info("overlay: {} frames{}{}; tracker: {} records, {} rejected, {} bytes skipped", overlay.times().frames,
+                 o->out.empty() ? "" : " -> " + o->out, video ? " (" + video->codec() + ")" : "", stats.records,
+                 stats.rejected_records, stats.skipped_bytes);
     if (const auto* lighting = overlay.live_lighting())
       spdlog::info("overlay: lighting scale {:.3f} after {} comparisons of the video with the map", lighting->scale(),
                    lighting->measurements());

@@ -1,20 +1,20 @@
 // lumar calibrate-response and lumar calibrate-vignetting: the camera's radiometry,
 // from a bracket of exposures and from flat-field images, optionally written into a
 // recording's session.json so that later overlays use it.
+#include <spdlog/spdlog.h>
 #include <fstream>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
-#include <spdlog/spdlog.h>
 
 #include "commands.h"
+#include "lumar/base/error.h"
 #include "lumar/calib/camera_file.h"
 #include "lumar/calib/camera_response.h"
 #include "lumar/calib/vignetting.h"
 #include "lumar/capture/durable_file.h"
 #include "lumar/capture/session.h"
-#include "lumar/base/error.h"
 
 namespace lumar::app {
 
@@ -72,9 +72,8 @@ void run_response(const ResponseOptions& o) {
   // Linear exposure at a few codes, per channel (BGR), normalised so 128 -> 1.
   nlohmann::json summary = {{"out", o.out}, {"images", o.images.size()}};
   for (int c = 0; c < 3; ++c)
-    summary["samples"][c == 0 ? "b" : (c == 1 ? "g" : "r")] = {response(c, 32), response(c, 64),
-                                                                         response(c, 128), response(c, 192),
-                                                                         response(c, 250)};
+    summary["samples"][c == 0 ? "b" : (c == 1 ? "g" : "r")] = {response(c, 32), response(c, 64), response(c, 128),
+                                                               response(c, 192), response(c, 250)};
   if (o.json) {
     std::printf("%s\n", summary.dump(2).c_str());
   } else {
@@ -99,8 +98,8 @@ void run_vignetting(const VignettingOptions& o) {
     const cv::Mat image = read_image8(path);
     if (image.cols != camera.width || image.rows != camera.height)
       throw InputError(path + ": is " + std::to_string(image.cols) + "x" + std::to_string(image.rows) + " but " +
-                       o.camera + " describes a " + std::to_string(camera.width) + "x" +
-                       std::to_string(camera.height) + " camera");
+                       o.camera + " describes a " + std::to_string(camera.width) + "x" + std::to_string(camera.height) +
+                       " camera");
     const cv::Mat linear = calib::linearize(image, response);
     if (sum.empty()) sum = cv::Mat::zeros(linear.size(), linear.type());
     sum += linear;
@@ -109,8 +108,12 @@ void run_vignetting(const VignettingOptions& o) {
   const calib::VignettingFit fit = calib::estimate_vignetting(sum, camera.cx, camera.cy);
   if (!o.session.empty()) update_session_radiometry(o.session, {{"vignetting", {fit.a, fit.b}}});
   if (o.json) {
-    const nlohmann::json j = {{"a", fit.a},           {"b", fit.b},           {"level", fit.level},
-                              {"residual_rms", fit.residual_rms}, {"inliers", fit.inliers}, {"samples", fit.samples}};
+    const nlohmann::json j = {{"a", fit.a},
+                              {"b", fit.b},
+                              {"level", fit.level},
+                              {"residual_rms", fit.residual_rms},
+                              {"inliers", fit.inliers},
+                              {"samples", fit.samples}};
     std::printf("%s\n", j.dump(2).c_str());
   } else {
     std::printf("vignetting gain 1 %+.4f r^2 %+.4f r^4 (residual %.2f %% RMS, %d of %d blocks)\n", fit.a, fit.b,
@@ -126,7 +129,8 @@ void register_radiometry(CLI::App& app) {
                                       "Recover the camera response (Debevec-Malik) from a bracket of exposures");
   response->add_option("--images", r->images, "The bracket: images of one static view")->required();
   response->add_option("--times", r->times, "Exposure time of each image, seconds, in the same order")
-      ->required()->check(CLI::PositiveNumber);
+      ->required()
+      ->check(CLI::PositiveNumber);
   response->add_option("--out", r->out, "Response JSON to write")->required();
   response->add_option("--hdr", r->hdr, "Also write the merged HDR image (.hdr)");
   response->add_option("--session", r->session, "Recording folder whose session.json should use this response");
@@ -138,8 +142,8 @@ void register_radiometry(CLI::App& app) {
   });
 
   auto v = std::make_shared<VignettingOptions>();
-  auto* vignetting = app.add_subcommand("calibrate-vignetting",
-                                        "Fit the radial fall-off 1 + a r^2 + b r^4 to flat-field images");
+  auto* vignetting =
+      app.add_subcommand("calibrate-vignetting", "Fit the radial fall-off 1 + a r^2 + b r^4 to flat-field images");
   vignetting->add_option("--images", v->images, "Flat-field images (averaged)")->required();
   vignetting->add_option("--camera", v->camera, "Camera file (its principal point and size)")->required();
   vignetting->add_option("--response", v->response, "Camera response JSON; default: sRGB");

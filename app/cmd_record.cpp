@@ -14,10 +14,10 @@
 #include <optional>
 
 #include "commands.h"
-#include "lumar/pipeline/live_inputs.h"
+#include "lumar/base/error.h"
 #include "lumar/capture/capture_thread.h"
 #include "lumar/capture/recording_writer.h"
-#include "lumar/base/error.h"
+#include "lumar/pipeline/live_inputs.h"
 #include "lumar/pipeline/stop_signal.h"
 
 namespace lumar::app {
@@ -43,7 +43,8 @@ double free_megabytes(const std::filesystem::path& dir) {
 }
 
 void run_record(const RecordOptions& o) {
-  if (o.in.source.empty()) throw InputError("record: give --source (video:FILE, images:DIR, v4l2:/dev/videoN, recording:DIR)");
+  if (o.in.source.empty())
+    throw InputError("record: give --source (video:FILE, images:DIR, v4l2:/dev/videoN, recording:DIR)");
   if (!(o.segment_seconds > 0) || o.segment_seconds > 60) throw InputError("--segment-seconds must be in (0, 60]");
   if (!(o.duration_s >= 0)) throw InputError("--duration must be 0 or more");
   if (std::error_code ec; std::filesystem::exists(o.out, ec))
@@ -105,7 +106,8 @@ void run_record(const RecordOptions& o) {
   try {
     const Nanos end = o.duration_s > 0 ? start + seconds_to_nanos(o.duration_s) : 0;
     capture::Frame frame;
-    while (!stop_requested() && (end == 0 || monotonic_now() < end) && (o.max_frames <= 0 || int(frames) < o.max_frames)) {
+    while (!stop_requested() && (end == 0 || monotonic_now() < end) &&
+           (o.max_frames <= 0 || int(frames) < o.max_frames)) {
       if (queue.pop(frame, 50'000'000)) {
         frame.time -= start;
         writer.add_frame(frame);
@@ -155,7 +157,8 @@ void run_record(const RecordOptions& o) {
       write_failed = true;
     }
   }
-  if (stop_reason.empty() && (capture.end() == capture::CaptureEnd::Vanished || capture.end() == capture::CaptureEnd::Failed))
+  if (stop_reason.empty() &&
+      (capture.end() == capture::CaptureEnd::Vanished || capture.end() == capture::CaptureEnd::Failed))
     stop_reason = capture.message();
   try {
     writer.close();
@@ -163,17 +166,18 @@ void run_record(const RecordOptions& o) {
     if (stop_reason.empty()) stop_reason = e.what();
   }
   const auto qs = queue.stats();
-  spdlog::info("record: {} frames in {} ({} read from the source), {} poses; back-pressure {} times, {:.1f} ms in total",
-               writer.frames_written(), o.out, capture.frames_read(), poses, qs.back_pressure,
-               double(qs.back_pressure_time) * 1e-6);
+  spdlog::info(
+      "record: {} frames in {} ({} read from the source), {} poses; back-pressure {} times, {:.1f} ms in total",
+      writer.frames_written(), o.out, capture.frames_read(), poses, qs.back_pressure,
+      double(qs.back_pressure_time) * 1e-6);
   if (driver) {
     const auto st = driver->status();
     spdlog::info("record: tracker {} records, {} rejected, {} skipped bytes", st.records, st.rejected_records,
                  st.skipped_bytes);
   }
   if (!stop_reason.empty()) {
-    const std::string kept = "; " + o.out + " holds the " + std::to_string(writer.frames_written()) +
-                             " frames written before it";
+    const std::string kept =
+        "; " + o.out + " holds the " + std::to_string(writer.frames_written()) + " frames written before it";
     if (input_failed || (capture.end() == capture::CaptureEnd::Failed && capture.input_error() && !write_failed))
       throw InputError(stop_reason + kept);
     throw RuntimeError(stop_reason + kept);
@@ -190,10 +194,12 @@ void register_record(CLI::App& app) {
   cmd->add_option("--out", o->out, "Recording directory to create (must not exist)")->required();
   add_live_input_options(cmd, o->in);
   cmd->add_option("--codec", o->codec, "Video codec: mjpeg (near-lossless) or ffv1 (lossless)")
-      ->check(CLI::IsMember({"mjpeg", "ffv1"}))->capture_default_str();
+      ->check(CLI::IsMember({"mjpeg", "ffv1"}))
+      ->capture_default_str();
   cmd->add_option("--quality", o->quality, "MJPEG quality")->check(CLI::Range(50, 100))->capture_default_str();
   cmd->add_option("--segment-seconds", o->segment_seconds,
-                  "Video segment length: at most this much video is lost in a crash")->capture_default_str();
+                  "Video segment length: at most this much video is lost in a crash")
+      ->capture_default_str();
   cmd->add_option("--duration", o->duration_s, "Stop after this many seconds (0: at the end of the source or Ctrl-C)")
       ->capture_default_str();
   cmd->add_option("--max-frames", o->max_frames, "Stop after this many frames (0: no limit)")->capture_default_str();

@@ -1,13 +1,13 @@
 // lumar regress: replay recordings through the overlay path and compare with their
 // expected results (golden frames, where the virtual object projects).
 #include <fmt/format.h>
+#include <spdlog/spdlog.h>
 #include <fstream>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
-#include <spdlog/spdlog.h>
 
 #include "commands.h"
 #include "lumar/base/error.h"
@@ -33,7 +33,8 @@ double projection_error_px(const CameraIntrinsics& camera, const std::vector<glm
                            const Pose& truth) {
   const Pose a = tracked.inverse(), b = truth.inverse();
   double sum = 0;
-  for (const auto& p : points) sum += glm::length(project_pinhole(camera, a.apply(p)) - project_pinhole(camera, b.apply(p)));
+  for (const auto& p : points)
+    sum += glm::length(project_pinhole(camera, a.apply(p)) - project_pinhole(camera, b.apply(p)));
   return points.empty() ? 0.0 : sum / points.size();
 }
 
@@ -118,7 +119,8 @@ Outcome regress_one(const fs::path& dir, bool update) {
     }
     const auto truth = overlay.replay().true_camera_pose(f.index);
     if (truth && f.T_world_camera)
-      tracked_errors.push_back(projection_error_px(overlay.compositor().output_camera(), points, *f.T_world_camera, *truth));
+      tracked_errors.push_back(
+          projection_error_px(overlay.compositor().output_camera(), points, *f.T_world_camera, *truth));
     return true;
   });
 
@@ -128,7 +130,8 @@ Outcome regress_one(const fs::path& dir, bool update) {
   std::size_t render_samples = 0;
   fs::create_directories(dir / "expected");
   for (std::int64_t index : golden) {
-    if (!outputs.count(index)) throw InputError(dir.string() + ": golden frame " + std::to_string(index) + " is not in the video");
+    if (!outputs.count(index))
+      throw InputError(dir.string() + ": golden frame " + std::to_string(index) + " is not in the video");
     const fs::path png = dir / "expected" / fmt::format("frame-{:06d}.png", index);
     if (update) {
       if (!cv::imwrite(png.string(), outputs[index])) throw RuntimeError(png.string() + ": cannot write");
@@ -173,9 +176,12 @@ Outcome regress_one(const fs::path& dir, bool update) {
   o.line = fmt::format(
       "{} {}: {} frames; golden PSNR min {} (>= {:.0f} dB); tracked-pose projection error mean {:.2f} px, worst "
       "frame {:.2f} px (mean <= {:.1f}); render vs cv::projectPoints {:.1e} px over {} pixels (<= {:.1f}){}",
-      o.pass ? "PASS" : "FAIL", dir.string(), frames.size(), update ? std::string("(updated)") : fmt::format("{:.1f} dB", psnr_min),
-      psnr_limit, tracked_mean, tracked_max, tracked_limit, render_error, render_samples, render_limit,
-      tracked_errors.size() == frames.size() ? "" : fmt::format("; {} frames lacked a pose", frames.size() - tracked_errors.size()));
+      o.pass ? "PASS" : "FAIL", dir.string(), frames.size(),
+      update ? std::string("(updated)") : fmt::format("{:.1f} dB", psnr_min), psnr_limit, tracked_mean, tracked_max,
+      tracked_limit, render_error, render_samples, render_limit,
+      tracked_errors.size() == frames.size()
+          ? ""
+          : fmt::format("; {} frames lacked a pose", frames.size() - tracked_errors.size()));
   return o;
 }
 

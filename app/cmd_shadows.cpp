@@ -1,15 +1,15 @@
 // lumar shadows: how much the scene's virtual objects (in their manifest poses) darken
 // given points on real surfaces: E_with / E_without per RGB channel (docs/shadows.md).
+#include <spdlog/spdlog.h>
 #include <cmath>
 #include <fstream>
 #include <memory>
-#include <spdlog/spdlog.h>
 #include <sstream>
 
 #include "commands.h"
 #include "lumar/base/error.h"
-#include "lumar/scene/scene.h"
 #include "lumar/lighting/shadows/shadow_methods.h"
+#include "lumar/scene/scene.h"
 
 namespace lumar::app {
 
@@ -20,9 +20,9 @@ struct ShadowsOptions {
 };
 
 // IN.csv: a header, then x,y,z,nx,ny,nz per line (normals need not be unit).
-void read_query(const std::filesystem::path& path, std::vector<glm::vec3>& positions,
-                std::vector<glm::vec3>& normals) {
-  if (!std::filesystem::is_regular_file(path)) throw InputError(path.string() + ": query file not found; check the path");
+void read_query(const std::filesystem::path& path, std::vector<glm::vec3>& positions, std::vector<glm::vec3>& normals) {
+  if (!std::filesystem::is_regular_file(path))
+    throw InputError(path.string() + ": query file not found; check the path");
   std::ifstream in(path);
   if (!in) throw InputError(path.string() + ": cannot open the query file for reading");
   std::string line;
@@ -100,8 +100,8 @@ void register_shadows(CLI::App& app) {
     const ShadowScene shadows(scene);
     const auto attenuation = shadow_attenuation(shadows, positions, normals, method);
     write_result(o->out, attenuation);
-    spdlog::info("shadows ({}): {} points, {} occluder(s) -> {}", o->method, positions.size(),
-                 shadows.objects().size(), o->out);
+    spdlog::info("shadows ({}): {} points, {} occluder(s) -> {}", o->method, positions.size(), shadows.objects().size(),
+                 o->out);
   });
 }
 

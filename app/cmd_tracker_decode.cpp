@@ -10,8 +10,8 @@
 #include <string>
 
 #include "commands.h"
-#include "lumar/capture/recording_format.h"
 #include "lumar/base/error.h"
+#include "lumar/capture/recording_format.h"
 #include "lumar/tracking/tracker_decode.h"
 // parse_tracker_chunks is private to capture/ (capture/src); the decoder needs exactly
 // that reader, so it is included from there rather than copied.
@@ -104,7 +104,8 @@ void run_decode(const DecodeOptions& o) {
 
 void register_tracker_decode(CLI::App& tracker) {
   auto o = std::make_shared<DecodeOptions>();
-  auto* cmd = tracker.add_subcommand("decode", "Decode raw tracker bytes (or a recording's tracker.raw) into CSV poses");
+  auto* cmd =
+      tracker.add_subcommand("decode", "Decode raw tracker bytes (or a recording's tracker.raw) into CSV poses");
   cmd->add_option("FILE", o->file, "Raw byte capture, or tracker.raw from a recording")->required();
   // Values are checked when the command runs, so a bad one gets the usual one-line error.
   cmd->add_option("--device", o->device, "Tracker model: isotrak2 or fastrak")->capture_default_str();

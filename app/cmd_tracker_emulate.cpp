@@ -13,9 +13,9 @@
 
 #include "commands.h"
 #include "lumar/base/error.h"
+#include "lumar/pipeline/stop_signal.h"
 #include "lumar/tracking/tracker_decode.h"
 #include "lumar/tracking/tracker_emulator.h"
-#include "lumar/pipeline/stop_signal.h"
 
 namespace lumar::app {
 
@@ -127,10 +127,11 @@ void run_emulate(const EmulateOptions& o) {
   }
   emulator.stop();
   const auto c = emulator.counters();
-  spdlog::info("emulate: {} records sent ({} dropped, {} with garbage, {} cut short), {} commands, {} status replies, "
-               "{} reinitialisations, {} disconnections",
-               c.records_sent, c.records_dropped, c.records_damaged, c.records_cut_short, c.commands, c.status_replies,
-               c.reinits, c.disconnects);
+  spdlog::info(
+      "emulate: {} records sent ({} dropped, {} with garbage, {} cut short), {} commands, {} status replies, "
+      "{} reinitialisations, {} disconnections",
+      c.records_sent, c.records_dropped, c.records_damaged, c.records_cut_short, c.commands, c.status_replies,
+      c.reinits, c.disconnects);
 }
 
 }  // namespace
@@ -160,7 +161,8 @@ void register_tracker_emulate(CLI::App& tracker) {
   cmd->add_option("--drop", o->drop, "Fraction of records never sent")->capture_default_str();
   cmd->add_option("--silence-every", o->silence_every_s, "Hang every this many seconds (0: never)");
   cmd->add_option("--silence-for", o->silence_for_s, "...for this many seconds (Ctrl-Y ends it)");
-  cmd->add_option("--disconnect-every", o->disconnect_every_s, "Make the pty vanish every this many seconds (0: never)");
+  cmd->add_option("--disconnect-every", o->disconnect_every_s,
+                  "Make the pty vanish every this many seconds (0: never)");
   cmd->add_option("--disconnect-for", o->disconnect_for_s, "...for this many seconds");
   cmd->add_option("--duration", o->duration_s, "Stop after this many seconds (0: at Ctrl-C or SIGTERM)");
   cmd->add_option("--sent-log", o->sent_log,

@@ -11,10 +11,10 @@
 #include <thread>
 
 #include "commands.h"
-#include "lumar/capture/recording_writer.h"
 #include "lumar/base/error.h"
-#include "lumar/tracking/tracker_driver.h"
+#include "lumar/capture/recording_writer.h"
 #include "lumar/pipeline/stop_signal.h"
+#include "lumar/tracking/tracker_driver.h"
 
 namespace lumar::app {
 
@@ -91,7 +91,8 @@ void run_record(const RecordOptions& o) {
   }
   const auto& bauds = tracking::supported_bauds();
   if (std::find(bauds.begin(), bauds.end(), serial.baud) == bauds.end())
-    throw InputError("--baud " + std::to_string(serial.baud) + " is not supported; use 9600, 19200, 38400, 57600 or 115200");
+    throw InputError("--baud " + std::to_string(serial.baud) +
+                     " is not supported; use 9600, 19200, 38400, 57600 or 115200");
 
   // The tracker part of session.json uses the keys of capture/session.h, so replay
   // tools decode tracker.raw with the settings the device was given.
@@ -152,10 +153,11 @@ void run_record(const RecordOptions& o) {
   drain();
   writer.close();
   const auto st = driver.status();
-  spdlog::info("record: {} poses; {} records, {} rejected, {} skipped bytes, {} bytes read; {} connections, {} "
-               "watchdog faults, {} failed resets",
-               poses, st.records, st.rejected_records, st.skipped_bytes, st.bytes_read, st.connects, st.watchdog_faults,
-               st.reset_attempts);
+  spdlog::info(
+      "record: {} poses; {} records, {} rejected, {} skipped bytes, {} bytes read; {} connections, {} "
+      "watchdog faults, {} failed resets",
+      poses, st.records, st.rejected_records, st.skipped_bytes, st.bytes_read, st.connects, st.watchdog_faults,
+      st.reset_attempts);
 }
 
 }  // namespace
@@ -175,7 +177,8 @@ void register_tracker_record(CLI::App& tracker) {
   cmd->add_option("--poll", o->poll_hz, "Poll with P at this rate instead of continuous mode (0: continuous)")
       ->capture_default_str();
   cmd->add_option("--latency-ms", o->latency_ms, "Device latency subtracted from pose times")->capture_default_str();
-  cmd->add_option("--watchdog", o->watchdog_s, "Seconds without a valid record before resetting")->capture_default_str();
+  cmd->add_option("--watchdog", o->watchdog_s, "Seconds without a valid record before resetting")
+      ->capture_default_str();
   cmd->add_option("--reinit-wait", o->reinit_wait_s, "Seconds to wait after Ctrl-Y")->capture_default_str();
   cmd->add_option("--duration", o->duration_s, "Stop after this many seconds (0: at Ctrl-C or SIGTERM)")
       ->capture_default_str();

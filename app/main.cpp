@@ -1,9 +1,9 @@
 // lumar: the command line. Each subcommand lives in its own file (cmd_*.cpp) and
 // registers itself through register_*(); errors become one line and an exit status.
+#include <spdlog/spdlog.h>
 #include <CLI/CLI.hpp>
 #include <cstdio>
 #include <cstdlib>
-#include <spdlog/spdlog.h>
 
 #include "commands.h"
 #include "lumar/base/error.h"

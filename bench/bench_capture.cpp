@@ -91,7 +91,8 @@ void register_size(cv::Size size) {
     for (auto _ : state) benchmark::DoNotOptimize(cv::imdecode(jpeg, cv::IMREAD_COLOR));
   })->Unit(benchmark::kMillisecond);
   for (const char* codec : {"mjpeg", "ffv1"}) {
-    benchmark::RegisterBenchmark((std::string("record_") + codec + "/" + t).c_str(), [size, codec](benchmark::State& state) {
+    benchmark::RegisterBenchmark((std::string("record_") + codec + "/" + t).c_str(), [size,
+                                                                                      codec](benchmark::State& state) {
       constexpr int kFrames = 60;
       const auto dir = std::filesystem::temp_directory_path() / fmt::format("lumar-bench-capture-{}", ::getpid());
       for (auto _ : state) {

@@ -6,18 +6,18 @@
 // docs/envmap_quality_vs_resolution.png.
 #include <benchmark/benchmark.h>
 
-#include <cmath>
 #include <fmt/format.h>
+#include <cmath>
 #include <random>
 
 #include "bench_report.h"
 #include "lumar/calib/camera_file.h"
 #include "lumar/envmap/envmap_quality.h"
 #include "lumar/envmap/envmap_stitcher.h"
-#include "lumar/sim/envmap_view.h"
 #include "lumar/envmap/hole_filling.h"
 #include "lumar/envmap/orientation_refinement.h"
 #include "lumar/envmap/sweep_path.h"
+#include "lumar/sim/envmap_view.h"
 
 using namespace lumar;
 
@@ -123,9 +123,12 @@ int main(int argc, char** argv) {
   quality.error_label = "median relative luminance error (%)";
   quality.x_label = "map width (pixels)";
   for (int width : {128, 256, 512, 1024}) {
-    quality.entries.push_back({fmt::format("tracker {}", width), 0, 100 * median_error(s.tracker, width), 0, double(width)});
-    quality.entries.push_back({fmt::format("refined {}", width), 0, 100 * median_error(refined.rotations, width), 0, double(width)});
-    quality.entries.push_back({fmt::format("truth {}", width), 0, 100 * median_error(s.truth, width), 0, double(width)});
+    quality.entries.push_back(
+        {fmt::format("tracker {}", width), 0, 100 * median_error(s.tracker, width), 0, double(width)});
+    quality.entries.push_back(
+        {fmt::format("refined {}", width), 0, 100 * median_error(refined.rotations, width), 0, double(width)});
+    quality.entries.push_back(
+        {fmt::format("truth {}", width), 0, 100 * median_error(s.truth, width), 0, double(width)});
   }
   quality.note = fmt::format("rotations: tracker {:.3f} deg RMS, refined {:.3f} deg RMS (180 frames, 60 brackets)",
                              rms(s.tracker), rms(refined.rotations));

@@ -12,11 +12,11 @@
 #include <random>
 
 #include "bench_report.h"
-#include "test_geometry.h"
+#include "lumar/base/latlong.h"
 #include "lumar/lighting/irradiance_reference.h"
 #include "lumar/lighting/irradiance_scene.h"
 #include "lumar/lighting/irradiance_volume.h"
-#include "lumar/base/latlong.h"
+#include "test_geometry.h"
 
 using namespace lumar;
 

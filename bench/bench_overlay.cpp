@@ -76,9 +76,18 @@ void replay_frame(benchmark::State& state) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  benchmark::RegisterBenchmark("decode_frame", decode_frame)->Unit(benchmark::kMillisecond)->MinTime(1.0)->UseRealTime();
-  benchmark::RegisterBenchmark("composite_frame", composite_frame)->Unit(benchmark::kMillisecond)->MinTime(2.0)->UseRealTime();
-  benchmark::RegisterBenchmark("replay_frame", replay_frame)->Unit(benchmark::kMillisecond)->MinTime(2.0)->UseRealTime();
+  benchmark::RegisterBenchmark("decode_frame", decode_frame)
+      ->Unit(benchmark::kMillisecond)
+      ->MinTime(1.0)
+      ->UseRealTime();
+  benchmark::RegisterBenchmark("composite_frame", composite_frame)
+      ->Unit(benchmark::kMillisecond)
+      ->MinTime(2.0)
+      ->UseRealTime();
+  benchmark::RegisterBenchmark("replay_frame", replay_frame)
+      ->Unit(benchmark::kMillisecond)
+      ->MinTime(2.0)
+      ->UseRealTime();
   benchmark::Initialize(&argc, argv);
   bench::CollectingReporter reporter;
   benchmark::RunSpecifiedBenchmarks(&reporter);
@@ -92,14 +101,11 @@ int main(int argc, char** argv) {
   report.name = "overlay_stages";
   report.title = "Overlay at 640x480, sample recording, Mesa llvmpipe: time per stage";
   report.baseline = "decode one video frame";
-  report.entries = {{"decode one video frame", decode->time_ms},
-                    {"upload frame", c.at("upload_ms")},
-                    {"background (undistort)", c.at("background_ms")},
-                    {"proxy depth", c.at("depth_ms")},
-                    {"virtual objects (volume)", c.at("objects_ms")},
-                    {"read back", c.at("readback_ms")},
-                    {"composite, all stages", composite->time_ms},
-                    {"replay: decode+pose+composite", replay->time_ms}};
+  report.entries = {
+      {"decode one video frame", decode->time_ms},       {"upload frame", c.at("upload_ms")},
+      {"background (undistort)", c.at("background_ms")}, {"proxy depth", c.at("depth_ms")},
+      {"virtual objects (volume)", c.at("objects_ms")},  {"read back", c.at("readback_ms")},
+      {"composite, all stages", composite->time_ms},     {"replay: decode+pose+composite", replay->time_ms}};
   report.compute_ratios();
   report.save(bench::results_dir());
   std::printf("replay throughput: %.1f frames/s\n", 1000.0 / replay->time_ms);

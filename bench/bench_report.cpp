@@ -1,10 +1,10 @@
 #include "bench_report.h"
 
+#include <fmt/format.h>
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
-#include <fmt/format.h>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
@@ -69,7 +69,9 @@ void BenchReport::write_chart(const std::filesystem::path& file) const {
     auto px = [&](double x) {
       return left + int((right - left) * (std::log10(std::max(x, std::pow(10, lx0))) - lx0) / (lx1 - lx0));
     };
-    auto py = [&](double e) { return bottom - int((bottom - top) * (std::log10(std::max(e, 1e-6)) - le0) / (le1 - le0)); };
+    auto py = [&](double e) {
+      return bottom - int((bottom - top) * (std::log10(std::max(e, 1e-6)) - le0) / (le1 - le0));
+    };
     for (double d = lx0; d <= lx1; d += 1)
       for (int m : {1, 2, 5}) {
         const double v = m * std::pow(10, d);
@@ -95,7 +97,10 @@ void BenchReport::write_chart(const std::filesystem::path& file) const {
       const bool front = std::none_of(entries.begin(), entries.end(), [&](const auto& o) {
         return &o != &e && o.x <= e.x && o.error <= e.error && (o.x < e.x || o.error < e.error);
       });
-      cv::circle(img, p, chosen ? 7 : 4, e.name == baseline ? kBar : chosen ? cv::Scalar(40, 160, 40) : kDot,
+      cv::circle(img, p, chosen ? 7 : 4,
+                 e.name == baseline ? kBar
+                 : chosen           ? cv::Scalar(40, 160, 40)
+                                    : kDot,
                  cv::FILLED, cv::LINE_AA);
       if (chosen || front || e.name == baseline)
         text(img, e.name, p + cv::Point(9, 4), chosen ? 0.45 : 0.36, chosen ? cv::Scalar(40, 130, 40) : kInk);
@@ -110,7 +115,8 @@ void BenchReport::write_chart(const std::filesystem::path& file) const {
       const int y = top + 34 * int(i);
       const int len = tmax > 0 ? int((right - left) * e.time_ms / tmax) : 0;
       text(img, e.name, {20, y + 18});
-      cv::rectangle(img, {left, y + 4}, {left + std::max(1, len), y + 24}, e.name == baseline ? kDot : kBar, cv::FILLED);
+      cv::rectangle(img, {left, y + 4}, {left + std::max(1, len), y + 24}, e.name == baseline ? kDot : kBar,
+                    cv::FILLED);
       text(img, fmt::format("{} ms  x{:.2f}", short_number(e.time_ms), e.ratio), {left + len + 8, y + 19});
     }
     text(img, fmt::format("ratios against '{}' measured in the same run", baseline), {20, H - 20}, 0.42);
@@ -126,7 +132,9 @@ void BenchReport::write_chart(const std::filesystem::path& file) const {
     const double lt0 = std::floor(std::log10(t0)), lt1 = std::ceil(std::log10(t1)) + (t1 == t0 ? 1 : 0);
     const double le0 = std::floor(std::log10(e0)), le1 = std::ceil(std::log10(e1)) + (e1 == e0 ? 1 : 0);
     auto px = [&](double t) { return left + int((right - left) * (std::log10(t) - lt0) / (lt1 - lt0)); };
-    auto py = [&](double e) { return bottom - int((bottom - top) * (std::log10(std::max(e, 1e-6)) - le0) / (le1 - le0)); };
+    auto py = [&](double e) {
+      return bottom - int((bottom - top) * (std::log10(std::max(e, 1e-6)) - le0) / (le1 - le0));
+    };
     for (double d = lt0; d <= lt1; d += 1) {
       cv::line(img, {px(std::pow(10, d)), top}, {px(std::pow(10, d)), bottom}, kGrid);
       text(img, short_number(std::pow(10, d)), {px(std::pow(10, d)) - 12, bottom + 20}, 0.4);

@@ -19,16 +19,16 @@ struct BenchEntry {
 };
 
 struct BenchReport {
-  std::string name;          // file stem: bench/results/<name>.json and .png
+  std::string name;  // file stem: bench/results/<name>.json and .png
   std::string title;
-  std::string baseline;      // entry whose time every ratio divides by
-  std::string error_label;   // what `error` measures, e.g. "mean relative irradiance error (%)"
+  std::string baseline;     // entry whose time every ratio divides by
+  std::string error_label;  // what `error` measures, e.g. "mean relative irradiance error (%)"
   // x/y chart: when entries carry `x`, the chart is `error` against `x` (log axes; x <= 0
   // sits at the left edge) labelled x_label; `highlight` names an entry drawn larger,
   // e.g. a choice; the Pareto front (no entry both lower and left) is labelled.
   std::string x_label;
   std::string highlight;
-  std::string note;          // one line printed under the chart
+  std::string note;  // one line printed under the chart
   std::vector<BenchEntry> entries;
 
   void compute_ratios();

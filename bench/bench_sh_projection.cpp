@@ -2,16 +2,16 @@
 // coefficients are projected from; the error is irradiance against a brute-force
 // integral over the full-resolution map. Baseline: projecting the full map.
 #include <benchmark/benchmark.h>
-#include <cmath>
-#include <opencv2/imgproc.hpp>
 #include <fmt/format.h>
+#include <cmath>
 #include <map>
+#include <opencv2/imgproc.hpp>
 #include <random>
 
 #include "bench_report.h"
-#include "lumar/scene/envmap.h"
 #include "lumar/base/latlong.h"
 #include "lumar/lighting/sh.h"
+#include "lumar/scene/envmap.h"
 
 using namespace lumar;
 
@@ -54,7 +54,8 @@ glm::dvec3 brute_force_irradiance(const EnvironmentMap& m, const glm::dvec3& n) 
   return e;
 }
 
-double mean_relative_error_percent(const SH9& sh, const std::vector<glm::dvec3>& ns, const std::vector<glm::dvec3>& ref) {
+double mean_relative_error_percent(const SH9& sh, const std::vector<glm::dvec3>& ns,
+                                   const std::vector<glm::dvec3>& ref) {
   double sum = 0;
   for (std::size_t i = 0; i < ns.size(); ++i) {
     const glm::dvec3 e = sh9_irradiance(sh, ns[i]);
@@ -94,8 +95,8 @@ int main(int argc, char** argv) {
     if (!result) continue;
     const std::string name = fmt::format("{}x{}", maps[f].width, maps[f].height);
     if (f == 1) report.baseline = name;
-    report.entries.push_back({name, result->time_ms,
-                              mean_relative_error_percent(project_radiance_sh9(maps[f]), ns, ref)});
+    report.entries.push_back(
+        {name, result->time_ms, mean_relative_error_percent(project_radiance_sh9(maps[f]), ns, ref)});
   }
   report.compute_ratios();
   report.save(bench::results_dir());

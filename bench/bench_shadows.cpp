@@ -9,20 +9,20 @@
 #include <benchmark/benchmark.h>
 #include <tbb/global_control.h>
 
+#include <fmt/format.h>
 #include <chrono>
 #include <cmath>
-#include <fmt/format.h>
 #include <glm/gtc/matrix_transform.hpp>
 #include <map>
 #include <memory>
 
 #include "bench_report.h"
-#include "lumar/scene/scene.h"
-#include "lumar/lighting/shadows/shadow_methods.h"
 #include "lumar/lighting/ray_scene.h"
 #include "lumar/lighting/shadows/object_shadows.h"
 #include "lumar/lighting/shadows/occluder_mesh.h"
+#include "lumar/lighting/shadows/shadow_methods.h"
 #include "lumar/lighting/shadows/shadow_occlusion.h"
+#include "lumar/scene/scene.h"
 
 using namespace lumar;
 
@@ -110,7 +110,6 @@ void run_frames(benchmark::State& state, Built& b, bool cull, int stride) {
   state.counters["walked"] = double(walked) / n;
 }
 
-
 double error_of(const std::vector<glm::vec3>& a) {
   const auto& ref = setup().reference;
   double sum = 0;
@@ -127,7 +126,8 @@ int main(int argc, char** argv) {
   Setup& s = setup();
   const auto& fig = s.scene->objects().at(0);
   const bool quick = std::getenv("LUMAR_SHADOW_BENCH_QUICK") != nullptr;
-  if (quick) s.reference.assign(s.receivers.positions.size(), glm::vec3(1.0f));
+  if (quick)
+    s.reference.assign(s.receivers.positions.size(), glm::vec3(1.0f));
   else {
     std::vector<ShadowScene::Object> objects{{fig.name, fig.model, error_pose()}};
     EnvironmentMap map = s.scene->map();
@@ -157,122 +157,137 @@ int main(int argc, char** argv) {
   }
   // The same, the figurine jumping ~0.3 m between frames: last frame's blockers no
   // longer help (the worst case of the walk). In the note, not the chart.
-  benchmark::RegisterBenchmark("lines/8/culled_jumping", [&](benchmark::State& state) {
-    run_frames(state, built.at(8), true, 40);
-  })->Unit(benchmark::kMillisecond)->MinTime(1.0);
+  benchmark::RegisterBenchmark("lines/8/culled_jumping",
+                               [&](benchmark::State& state) { run_frames(state, built.at(8), true, 40); })
+      ->Unit(benchmark::kMillisecond)
+      ->MinTime(1.0);
 
   // Every line against the posed figurine as an Embree instance (world space, one ray
   // stream): the baseline as measured before the model-space one. In the note, not the
   // chart (its label would sit on the model-space one's).
-  benchmark::RegisterBenchmark("lines/8/instanced", [&](benchmark::State& state) {
-    tbb::global_control one_core(tbb::global_control::max_allowed_parallelism, 1);
-    const ShadowLines& lines = built.at(8).shadows->lines();
-    RayScene scene;
-    const int id = scene.add_instance(fig.model, error_pose());
-    std::vector<Ray> rays(lines.lines.size());
-    std::vector<std::uint8_t> blocked(rays.size());
-    const float t_far = shadow_ray_t_far(lines.distant);
-    int frame = 1;
-    std::size_t count = 0;
-    for (auto _ : state) {
-      scene.set_instance_transform(id, pose_at(frame++));
-      scene.commit();
-      for (std::size_t li = 0; li < rays.size(); ++li) {
-        const ShadowLine& l = lines.lines[li];
-        const glm::vec3 from = lines.origins[l.receiver];
-        rays[li] = Ray{from, 0.0f, lines.line_end(l) - from, t_far};
-      }
-      scene.occluded(rays, blocked, true);
-      for (const std::uint8_t b : blocked) count += b;
-    }
-    state.counters["blocked"] = double(count) / double(state.iterations());
-  })->Unit(benchmark::kMillisecond)->MinTime(1.0);
+  benchmark::RegisterBenchmark("lines/8/instanced",
+                               [&](benchmark::State& state) {
+                                 tbb::global_control one_core(tbb::global_control::max_allowed_parallelism, 1);
+                                 const ShadowLines& lines = built.at(8).shadows->lines();
+                                 RayScene scene;
+                                 const int id = scene.add_instance(fig.model, error_pose());
+                                 std::vector<Ray> rays(lines.lines.size());
+                                 std::vector<std::uint8_t> blocked(rays.size());
+                                 const float t_far = shadow_ray_t_far(lines.distant);
+                                 int frame = 1;
+                                 std::size_t count = 0;
+                                 for (auto _ : state) {
+                                   scene.set_instance_transform(id, pose_at(frame++));
+                                   scene.commit();
+                                   for (std::size_t li = 0; li < rays.size(); ++li) {
+                                     const ShadowLine& l = lines.lines[li];
+                                     const glm::vec3 from = lines.origins[l.receiver];
+                                     rays[li] = Ray{from, 0.0f, lines.line_end(l) - from, t_far};
+                                   }
+                                   scene.occluded(rays, blocked, true);
+                                   for (const std::uint8_t b : blocked) count += b;
+                                 }
+                                 state.counters["blocked"] = double(count) / double(state.iterations());
+                               })
+      ->Unit(benchmark::kMillisecond)
+      ->MinTime(1.0);
 
   // Embree's cost for the blocked lines alone: only the lines that ARE blocked at each
   // pose (known from tracing every line beforehand), traced one by one as the culled
   // method traces the candidates it cannot prove blocked by a walk. With Embree alone,
   // no culling could get below this; the ratio target needs 1/20 of "all".
-  benchmark::RegisterBenchmark("lines/8/blocked_only", [&](benchmark::State& state) {
-    tbb::global_control one_core(tbb::global_control::max_allowed_parallelism, 1);
-    const ShadowLines& lines = built.at(8).shadows->lines();
-    LineShadows oracle(lines);
-    oracle.add_object(fig.model, error_pose());
-    oracle.set_culling(false);
-    const OccluderMesh mesh(fig.model);
-    const float t_far = shadow_ray_t_far(lines.distant);
-    constexpr int kPoses = 16;
-    std::vector<glm::mat4> model_from_world;
-    std::vector<std::vector<std::uint32_t>> blocked;
-    for (int k = 1; k <= kPoses; ++k) {
-      oracle.set_object_pose(0, pose_at(k));
-      oracle.update();
-      blocked.push_back(oracle.blocked_lines());
-      model_from_world.push_back(glm::mat4(glm::inverse(pose_at(k))));
-    }
-    int frame = 0;
-    std::size_t count = 0;
-    for (auto _ : state) {
-      const int k = frame++ % kPoses;
-      const glm::mat4& M = model_from_world[std::size_t(k)];
-      for (const std::uint32_t li : blocked[std::size_t(k)]) {
-        const ShadowLine& l = lines.lines[li];
-        const glm::vec3 a = glm::vec3(M * glm::vec4(lines.origins[l.receiver], 1.0f));
-        const glm::vec3 b = glm::vec3(M * glm::vec4(lines.line_end(l), 1.0f));
-        count += mesh.occluded(a, b - a, t_far);
-      }
-    }
-    state.counters["blocked"] = double(count) / double(state.iterations());
-  })->Unit(benchmark::kMillisecond)->MinTime(1.0);
+  benchmark::RegisterBenchmark("lines/8/blocked_only",
+                               [&](benchmark::State& state) {
+                                 tbb::global_control one_core(tbb::global_control::max_allowed_parallelism, 1);
+                                 const ShadowLines& lines = built.at(8).shadows->lines();
+                                 LineShadows oracle(lines);
+                                 oracle.add_object(fig.model, error_pose());
+                                 oracle.set_culling(false);
+                                 const OccluderMesh mesh(fig.model);
+                                 const float t_far = shadow_ray_t_far(lines.distant);
+                                 constexpr int kPoses = 16;
+                                 std::vector<glm::mat4> model_from_world;
+                                 std::vector<std::vector<std::uint32_t>> blocked;
+                                 for (int k = 1; k <= kPoses; ++k) {
+                                   oracle.set_object_pose(0, pose_at(k));
+                                   oracle.update();
+                                   blocked.push_back(oracle.blocked_lines());
+                                   model_from_world.push_back(glm::mat4(glm::inverse(pose_at(k))));
+                                 }
+                                 int frame = 0;
+                                 std::size_t count = 0;
+                                 for (auto _ : state) {
+                                   const int k = frame++ % kPoses;
+                                   const glm::mat4& M = model_from_world[std::size_t(k)];
+                                   for (const std::uint32_t li : blocked[std::size_t(k)]) {
+                                     const ShadowLine& l = lines.lines[li];
+                                     const glm::vec3 a = glm::vec3(M * glm::vec4(lines.origins[l.receiver], 1.0f));
+                                     const glm::vec3 b = glm::vec3(M * glm::vec4(lines.line_end(l), 1.0f));
+                                     count += mesh.occluded(a, b - a, t_far);
+                                   }
+                                 }
+                                 state.counters["blocked"] = double(count) / double(state.iterations());
+                               })
+      ->Unit(benchmark::kMillisecond)
+      ->MinTime(1.0);
 
   // Objects shadowing each other: two figurines side by side (about 0.15 m apart), one
   // moving a centimetre per frame, with the default emitter samples and with fewer.
   std::map<int, std::size_t> object_samples;
   for (const int per_patch : {8, 2}) {
     const std::string name = fmt::format("objects/{}", per_patch);
-    benchmark::RegisterBenchmark(name.c_str(), [&, per_patch](benchmark::State& state) {
-      tbb::global_control one_core(tbb::global_control::max_allowed_parallelism, 1);
-      const Mesh posed = transformed(fig.model, error_pose());
-      EmitterOptions options;
-      options.samples_per_patch = per_patch;
-      const Emitters emitters = s.scene->emitters(posed.positions, posed.normals, options);
-      object_samples[per_patch] = emitters.samples.size();
-      ObjectShadows shadows(emitters);
-      shadows.add_object(fig.model, error_pose());
-      const glm::dmat4 beside = glm::translate(glm::dmat4(1.0), glm::dvec3(0.6, 0, 0.05));
-      const int b = shadows.add_object(fig.model, beside * error_pose());
-      int frame = 0;
-      std::size_t shadowed = 0, rays = 0, blocked = 0, walked = 0;
-      for (auto _ : state) {
-        const glm::dvec3 step(0.01 * (frame++ % 6 + 1), 0, 0);
-        shadows.set_object_pose(b, glm::translate(glm::dmat4(1.0), step) * beside * error_pose());
-        shadows.update();
-        shadowed += shadows.stats().vertices_shadowed, rays += shadows.stats().rays_traced;
-        blocked += shadows.stats().lines_blocked, walked += shadows.stats().lines_walked;
-      }
-      state.counters["vertices_shadowed"] = double(shadowed) / double(state.iterations());
-      state.counters["rays"] = double(rays) / double(state.iterations());
-      state.counters["blocked"] = double(blocked) / double(state.iterations());
-      state.counters["walked"] = double(walked) / double(state.iterations());
-    })->Unit(benchmark::kMillisecond)->MinTime(1.0);
+    benchmark::RegisterBenchmark(name.c_str(),
+                                 [&, per_patch](benchmark::State& state) {
+                                   tbb::global_control one_core(tbb::global_control::max_allowed_parallelism, 1);
+                                   const Mesh posed = transformed(fig.model, error_pose());
+                                   EmitterOptions options;
+                                   options.samples_per_patch = per_patch;
+                                   const Emitters emitters = s.scene->emitters(posed.positions, posed.normals, options);
+                                   object_samples[per_patch] = emitters.samples.size();
+                                   ObjectShadows shadows(emitters);
+                                   shadows.add_object(fig.model, error_pose());
+                                   const glm::dmat4 beside = glm::translate(glm::dmat4(1.0), glm::dvec3(0.6, 0, 0.05));
+                                   const int b = shadows.add_object(fig.model, beside * error_pose());
+                                   int frame = 0;
+                                   std::size_t shadowed = 0, rays = 0, blocked = 0, walked = 0;
+                                   for (auto _ : state) {
+                                     const glm::dvec3 step(0.01 * (frame++ % 6 + 1), 0, 0);
+                                     shadows.set_object_pose(
+                                         b, glm::translate(glm::dmat4(1.0), step) * beside * error_pose());
+                                     shadows.update();
+                                     shadowed += shadows.stats().vertices_shadowed, rays += shadows.stats().rays_traced;
+                                     blocked += shadows.stats().lines_blocked, walked += shadows.stats().lines_walked;
+                                   }
+                                   state.counters["vertices_shadowed"] = double(shadowed) / double(state.iterations());
+                                   state.counters["rays"] = double(rays) / double(state.iterations());
+                                   state.counters["blocked"] = double(blocked) / double(state.iterations());
+                                   state.counters["walked"] = double(walked) / double(state.iterations());
+                                 })
+        ->Unit(benchmark::kMillisecond)
+        ->MinTime(1.0);
   }
 
   // The 2004 method per frame: every line against the bounding sphere.
-  const Emitters thresholded = s.scene->emitters(s.receivers.positions, s.receivers.normals,
-                                                 sphere_baseline_emitter_options());
+  const Emitters thresholded =
+      s.scene->emitters(s.receivers.positions, s.receivers.normals, sphere_baseline_emitter_options());
   {
     const std::vector<BoundingSphere> spheres{bounding_sphere(fig.model, error_pose())};
-    errors["sphere"] = error_of(sphere_attenuation(s.receivers.positions, s.receivers.normals, thresholded,
-                                                   s.scene->proxy(), spheres));
+    errors["sphere"] = error_of(
+        sphere_attenuation(s.receivers.positions, s.receivers.normals, thresholded, s.scene->proxy(), spheres));
   }
-  benchmark::RegisterBenchmark("sphere", [&](benchmark::State& state) {
-    tbb::global_control one_core(tbb::global_control::max_allowed_parallelism, 1);
-    int frame = 1;
-    for (auto _ : state) {
-      const std::vector<BoundingSphere> spheres{bounding_sphere(fig.model, pose_at(frame++))};
-      benchmark::DoNotOptimize(
-          sphere_attenuation(s.receivers.positions, s.receivers.normals, thresholded, s.scene->proxy(), spheres));
-    }
-  })->Unit(benchmark::kMillisecond)->MinTime(1.0);
+  benchmark::RegisterBenchmark(
+      "sphere",
+      [&](benchmark::State& state) {
+        tbb::global_control one_core(tbb::global_control::max_allowed_parallelism, 1);
+        int frame = 1;
+        for (auto _ : state) {
+          const std::vector<BoundingSphere> spheres{bounding_sphere(fig.model, pose_at(frame++))};
+          benchmark::DoNotOptimize(
+              sphere_attenuation(s.receivers.positions, s.receivers.normals, thresholded, s.scene->proxy(), spheres));
+        }
+      })
+      ->Unit(benchmark::kMillisecond)
+      ->MinTime(1.0);
 
   benchmark::Initialize(&argc, argv);
   bench::CollectingReporter reporter;
@@ -280,8 +295,8 @@ int main(int argc, char** argv) {
 
   bench::BenchReport report;
   report.name = "shadow_error_vs_time";
-  report.title = fmt::format("Moving figurine's shadow, {} receivers x 50 patches, one core",
-                             s.receivers.positions.size());
+  report.title =
+      fmt::format("Moving figurine's shadow, {} receivers x 50 patches, one core", s.receivers.positions.size());
   report.baseline = "2004 sphere";
   report.error_label = "mean |attenuation - reference| where reference < 0.98";
   for (const auto& [key, err] : errors) {
@@ -323,13 +338,13 @@ int main(int argc, char** argv) {
   fmt::print("{}\n", report.note);
   for (int k : samples)
     fmt::print("samples/patch {}: {} lines kept of {} candidates, precompute {:.0f} ms, error {:.4f}\n", k,
-               built[k].lines, built[k].candidates, built[k].precompute_ms,
-               errors[fmt::format("lines/{}/culled", k)]);
+               built[k].lines, built[k].candidates, built[k].precompute_ms, errors[fmt::format("lines/{}/culled", k)]);
   fmt::print("2004 sphere error {:.4f}\n", errors["sphere"]);
   if (blocked_only)
-    fmt::print("tracing only the lines that are blocked with Embree: {:.2f} ms per frame, {:.1f}x faster than all "
-               "traced\n",
-               blocked_only->time_ms, all ? all->time_ms / blocked_only->time_ms : 0.0);
+    fmt::print(
+        "tracing only the lines that are blocked with Embree: {:.2f} ms per frame, {:.1f}x faster than all "
+        "traced\n",
+        blocked_only->time_ms, all ? all->time_ms / blocked_only->time_ms : 0.0);
   for (const int per_patch : {8, 2})
     if (const auto* r = reporter.find(fmt::format("objects/{}", per_patch)))
       fmt::print("two figurines shadowing each other ({} vertices each, {} emitter samples): {:.1f} ms per update\n",

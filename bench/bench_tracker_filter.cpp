@@ -39,7 +39,7 @@ using namespace lumar::tracking;
 
 namespace {
 
-constexpr double kFx = 536.0;              // px per radian at 640x480 (webcam calibration)
+constexpr double kFx = 536.0;  // px per radian at 640x480 (webcam calibration)
 constexpr double kSweepDegPerSecond = 30.0;
 constexpr Nanos kRestWarmup = 10 * kNanosPerSecond;  // the slowest filters settle; not measured
 constexpr Nanos kMotionStart = 4 * kNanosPerSecond;  // the sweep starts from rest here
@@ -156,8 +156,8 @@ int main(int argc, char** argv) {
   for (double d_cutoff : {1.0, 0.1})  // 1 Hz is Casiez et al.'s default
     for (double min_cutoff : {0.05, 0.2, 1.0})
       for (double beta : {0.0, 0.3, 1.0, 3.0, 10.0, 30.0})
-        settings.push_back({fmt::format("fc{:g} b{:g} d{:g}", min_cutoff, beta, d_cutoff),
-                            one_euro(min_cutoff, beta, d_cutoff)});
+        settings.push_back(
+            {fmt::format("fc{:g} b{:g} d{:g}", min_cutoff, beta, d_cutoff), one_euro(min_cutoff, beta, d_cutoff)});
 
   // Cost per sample, for the record (the filter is a few slerps).
   const PoseFilterSettings timed = one_euro(0.1, 10.0, 1.0);
@@ -216,12 +216,13 @@ int main(int argc, char** argv) {
   if (choice) report.highlight = choice->name;
   const Row& raw = rows.front();
   auto px_at_sweep = [](double ms) { return deg_to_px(ms * 1e-3 * kSweepDegPerSecond); };
-  report.note = choice ? fmt::format("raw {:.3f} deg = {:.2f} px RMS. chosen {}: {:.3f} deg = {:.2f} px, lag {:.1f} ms, "
-                                     "onset {:.1f} ms ({:.1f} px at 30 deg/s)",
-                                     raw.jitter_deg, deg_to_px(raw.jitter_deg), choice->name, choice->jitter_deg,
-                                     deg_to_px(choice->jitter_deg), choice->lag_ms, choice->onset_ms,
-                                     px_at_sweep(drag_ms(*choice)))
-                       : "no setting reaches 1 px RMS at rest";
+  report.note =
+      choice ? fmt::format(
+                   "raw {:.3f} deg = {:.2f} px RMS. chosen {}: {:.3f} deg = {:.2f} px, lag {:.1f} ms, "
+                   "onset {:.1f} ms ({:.1f} px at 30 deg/s)",
+                   raw.jitter_deg, deg_to_px(raw.jitter_deg), choice->name, choice->jitter_deg,
+                   deg_to_px(choice->jitter_deg), choice->lag_ms, choice->onset_ms, px_at_sweep(drag_ms(*choice)))
+             : "no setting reaches 1 px RMS at rest";
   report.compute_ratios();
   report.save(bench::results_dir());
   const auto docs = std::filesystem::path(LUMAR_SOURCE_DIR) / "docs";
@@ -243,7 +244,8 @@ int main(int argc, char** argv) {
       const Row& r = rows[i];
       const auto& f = settings[i].filter;
       csv << fmt::format("{},{},{},{},{:.4f},{:.3f},{:.3f},{:.2f},{:.2f},{:.2f}\n", r.name,
-                         f ? fmt::format("{:g}", f->rotation.min_cutoff_hz) : "", f ? fmt::format("{:g}", f->rotation.beta) : "",
+                         f ? fmt::format("{:g}", f->rotation.min_cutoff_hz) : "",
+                         f ? fmt::format("{:g}", f->rotation.beta) : "",
                          f ? fmt::format("{:g}", f->rotation.d_cutoff_hz) : "", r.jitter_deg, deg_to_px(r.jitter_deg),
                          r.jitter_mm, r.lag_ms, r.onset_ms, px_at_sweep(drag_ms(r)));
     }

@@ -41,15 +41,18 @@ void save_calibration_report(const std::filesystem::path& path, const RobustCali
     fs << "avg_reprojection_error" << r.camera.avg_reprojection_error;
     fs << "per_view_reprojection_errors" << cv::Mat(r.per_view_rms, true);
     fs << "std_deviations_intrinsics" << cv::Mat(std::vector<double>(r.std_dev.begin(), r.std_dev.end()), true);
-    fs << "views_used" << "[";
+    fs << "views_used"
+       << "[";
     for (const auto& v : r.used_views) fs << v;
     fs << "]";
-    fs << "views_rejected" << "[";
+    fs << "views_rejected"
+       << "[";
     for (const auto& v : r.rejected)
-      fs << "{" << "file" << v.name << "rms" << v.rms_px << "threshold" << v.threshold_px << "round" << v.round
-         << "}";
+      fs << "{"
+         << "file" << v.name << "rms" << v.rms_px << "threshold" << v.threshold_px << "round" << v.round << "}";
     fs << "]";
-    fs << "views_without_board" << "[";
+    fs << "views_without_board"
+       << "[";
     for (const auto& v : r.views_without_board) fs << v;
     fs << "]";
     fs << "initial_reprojection_error" << r.initial_rms;
@@ -62,8 +65,8 @@ void save_calibration_report(const std::filesystem::path& path, const RobustCali
   rename_into_place(tmp, path, "calibration file");
 }
 
-void write_coverage_image(const std::filesystem::path& path, const BoardViews& views,
-                          const RobustCalibrationResult& r, const RobustCalibrationOptions& o) {
+void write_coverage_image(const std::filesystem::path& path, const BoardViews& views, const RobustCalibrationResult& r,
+                          const RobustCalibrationOptions& o) {
   const cv::Size size = views.image_size;
   cv::Mat img(size, CV_8UC3, cv::Scalar(40, 40, 40));
   auto cell = [&](int x, int y) {

@@ -8,8 +8,7 @@ namespace lumar::calib {
 
 CameraFile load_camera_file(const std::filesystem::path& path) {
   const std::string name = path.string();
-  if (!std::filesystem::is_regular_file(path))
-    throw InputError(name + ": camera calibration file not found");
+  if (!std::filesystem::is_regular_file(path)) throw InputError(name + ": camera calibration file not found");
   cv::FileStorage fs;
   try {
     if (!fs.open(name, cv::FileStorage::READ | cv::FileStorage::FORMAT_YAML))
@@ -29,8 +28,7 @@ CameraFile load_camera_file(const std::filesystem::path& path) {
   } catch (const cv::Exception&) {
     throw InputError(name + ": malformed calibration entries");
   }
-  if (K.rows != 3 || K.cols != 3)
-    throw InputError(name + ": camera_matrix is missing or not 3x3");
+  if (K.rows != 3 || K.cols != 3) throw InputError(name + ": camera_matrix is missing or not 3x3");
   if (D.total() != 4 && D.total() != 5)
     throw InputError(name + ": distortion_coefficients must hold 4 or 5 values (k1 k2 p1 p2 [k3])");
   K.convertTo(K, CV_64F);
@@ -43,8 +41,7 @@ CameraFile load_camera_file(const std::filesystem::path& path) {
   c.cx = K.at<double>(0, 2);
   c.cy = K.at<double>(1, 2);
   for (size_t i = 0; i < D.total(); ++i) c.distortion[i] = D.at<double>(int(i));
-  if (!c.is_valid())
-    throw InputError(name + ": image size or focal lengths are missing, non-positive or not finite");
+  if (!c.is_valid()) throw InputError(name + ": image size or focal lengths are missing, non-positive or not finite");
   return out;
 }
 

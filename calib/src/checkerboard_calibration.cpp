@@ -45,8 +45,9 @@ BoardViews detect_checkerboard_views(const std::vector<NamedImage>& images, cv::
       grey = named.image;
     std::vector<cv::Point2f> corners;
     // FAST_CHECK: video frames without the board are rejected quickly.
-    if (!cv::findChessboardCorners(grey, inner_corners, corners,
-                                   cv::CALIB_CB_ADAPTIVE_THRESH | cv::CALIB_CB_NORMALIZE_IMAGE | cv::CALIB_CB_FAST_CHECK)) {
+    if (!cv::findChessboardCorners(
+            grey, inner_corners, corners,
+            cv::CALIB_CB_ADAPTIVE_THRESH | cv::CALIB_CB_NORMALIZE_IMAGE | cv::CALIB_CB_FAST_CHECK)) {
       result.views_without_board.push_back(named.name);
       continue;
     }
@@ -63,12 +64,13 @@ BoardViews detect_checkerboard_views(const std::vector<NamedImage>& images, cv::
     result.objects.push_back(board);
     result.names.push_back(named.name);
   }
-  require_board_views(result, images.size(), size_text(inner_corners) + " inner-corner board (inner corners, not squares)");
+  require_board_views(result, images.size(),
+                      size_text(inner_corners) + " inner-corner board (inner corners, not squares)");
   return result;
 }
 
-CalibrationResult calibrate_checkerboard(const std::vector<std::filesystem::path>& images,
-                                         cv::Size inner_corners, double square_size_m) {
+CalibrationResult calibrate_checkerboard(const std::vector<std::filesystem::path>& images, cv::Size inner_corners,
+                                         double square_size_m) {
   const BoardViews views = detect_checkerboard_views(load_board_images(images), inner_corners, square_size_m);
   const auto& image_points = views.corners;
   const cv::Size image_size = views.image_size;

@@ -5,8 +5,8 @@
 #include <limits>
 #include <opencv2/calib3d.hpp>
 
-#include "lumar/calib/board_pose.h"
 #include "lumar/base/error.h"
+#include "lumar/calib/board_pose.h"
 
 namespace lumar::calib {
 
@@ -21,8 +21,8 @@ std::vector<int> spread_rotations(const std::vector<glm::dquat>& rotations, int 
     int best = -1;
     double best_angle = -1;
     for (int i = 0; i < n; ++i) {
-      nearest[std::size_t(i)] =
-          std::min(nearest[std::size_t(i)], rotation_angle_deg(rotations[std::size_t(i)], rotations[std::size_t(next)]));
+      nearest[std::size_t(i)] = std::min(nearest[std::size_t(i)],
+                                         rotation_angle_deg(rotations[std::size_t(i)], rotations[std::size_t(next)]));
       if (nearest[std::size_t(i)] > best_angle) best_angle = nearest[std::size_t(i)], best = i;
     }
     if (best_angle <= 0) break;  // every remaining rotation repeats a picked one
@@ -51,11 +51,16 @@ namespace {
 
 cv::HandEyeCalibrationMethod to_cv(HandEyeMethod m) {
   switch (m) {
-    case HandEyeMethod::Tsai: return cv::CALIB_HAND_EYE_TSAI;
-    case HandEyeMethod::Park: return cv::CALIB_HAND_EYE_PARK;
-    case HandEyeMethod::Horaud: return cv::CALIB_HAND_EYE_HORAUD;
-    case HandEyeMethod::Andreff: return cv::CALIB_HAND_EYE_ANDREFF;
-    case HandEyeMethod::Daniilidis: return cv::CALIB_HAND_EYE_DANIILIDIS;
+    case HandEyeMethod::Tsai:
+      return cv::CALIB_HAND_EYE_TSAI;
+    case HandEyeMethod::Park:
+      return cv::CALIB_HAND_EYE_PARK;
+    case HandEyeMethod::Horaud:
+      return cv::CALIB_HAND_EYE_HORAUD;
+    case HandEyeMethod::Andreff:
+      return cv::CALIB_HAND_EYE_ANDREFF;
+    case HandEyeMethod::Daniilidis:
+      return cv::CALIB_HAND_EYE_DANIILIDIS;
   }
   return cv::CALIB_HAND_EYE_PARK;
 }
@@ -78,7 +83,7 @@ HandEyeSolution solve_hand_eye(const std::vector<Pose>& T_transmitter_sensor, co
     for (std::size_t b = a + 1; b < out.views_used.size(); ++b)
       out.min_pair_rotation_deg =
           std::min(out.min_pair_rotation_deg, rotation_angle_deg(sensor_rotations[std::size_t(out.views_used[a])],
-                                                                   sensor_rotations[std::size_t(out.views_used[b])]));
+                                                                 sensor_rotations[std::size_t(out.views_used[b])]));
 
   std::vector<cv::Mat> R_gripper2base, t_gripper2base, R_target2cam, t_target2cam;
   for (int i : out.views_used) {

@@ -28,7 +28,8 @@ namespace {
 // Linear interpolation of the speed at t; false outside the series or across a gap.
 bool speed_at(const std::vector<AngularSpeedSample>& s, Nanos t, Nanos max_gap, double& v) {
   if (s.empty() || t < s.front().time || t > s.back().time) return false;
-  const auto it = std::lower_bound(s.begin(), s.end(), t, [](const AngularSpeedSample& a, Nanos x) { return a.time < x; });
+  const auto it =
+      std::lower_bound(s.begin(), s.end(), t, [](const AngularSpeedSample& a, Nanos x) { return a.time < x; });
   if (it->time == t) {
     v = it->speed_deg_s;
     return true;
@@ -86,14 +87,16 @@ TimeOffsetEstimate estimate_time_offset(const std::vector<AngularSpeedSample>& v
     if (best < 0 || r > out.curve[std::size_t(best)]) best = k + steps, out.samples = int(x.size());
   }
   if (best < 0)
-    throw InputError(min_samples < 10 ? "time offset: the video and the tracker overlap too little to compare their motion"
-                                      : "time offset: the angular speed is constant, nothing to correlate; turn the camera "
-                                        "at varying speed while filming the board");
+    throw InputError(min_samples < 10
+                         ? "time offset: the video and the tracker overlap too little to compare their motion"
+                         : "time offset: the angular speed is constant, nothing to correlate; turn the camera "
+                           "at varying speed while filming the board");
   out.peak_correlation = out.curve[std::size_t(best)];
   out.correlation_at_zero = out.curve[std::size_t(steps)];
   double refined = best - steps;
   if (best > 0 && best < 2 * steps && out.curve[std::size_t(best - 1)] > -2 && out.curve[std::size_t(best + 1)] > -2) {
-    const double l = out.curve[std::size_t(best - 1)], c = out.curve[std::size_t(best)], r = out.curve[std::size_t(best + 1)];
+    const double l = out.curve[std::size_t(best - 1)], c = out.curve[std::size_t(best)],
+                 r = out.curve[std::size_t(best + 1)];
     const double denom = l - 2 * c + r;
     if (denom < 0) refined += std::clamp(0.5 * (l - r) / denom, -0.5, 0.5);
   }

@@ -2,8 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
-#include <optional>
 #include <opencv2/core.hpp>
+#include <optional>
 #include <string>
 
 #include "lumar/base/error.h"
@@ -13,7 +13,7 @@ namespace lumar::calib {
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
-constexpr int kParams = 13;                    // X (rotation, translation), Z (same), offset
+constexpr int kParams = 13;  // X (rotation, translation), Z (same), offset
 
 double median(std::vector<double> v) {
   if (v.empty()) return 0;
@@ -48,7 +48,8 @@ struct CameraPath {
     const std::size_t i = std::size_t(it - times.begin());
     if (*it == t) return T_board_camera[i];
     if (times[i] - times[i - 1] > max_gap) return std::nullopt;
-    return interpolate(T_board_camera[i - 1], T_board_camera[i], double(t - times[i - 1]) / double(times[i] - times[i - 1]));
+    return interpolate(T_board_camera[i - 1], T_board_camera[i],
+                       double(t - times[i - 1]) / double(times[i] - times[i - 1]));
   }
 };
 
@@ -200,11 +201,12 @@ RigCalibrationResult calibrate_rig(const std::vector<BoardView>& views_in, const
     throw InputError(where + "only " + std::to_string(views.size()) + " views have a consistent board pose; at least " +
                      std::to_string(o.min_views) + " are needed");
   for (const auto& v : views)
-    out.rotation_range_deg =
-        std::max(out.rotation_range_deg, rotation_angle_deg(views.front().T_camera_board.rotation, v.T_camera_board.rotation));
+    out.rotation_range_deg = std::max(
+        out.rotation_range_deg, rotation_angle_deg(views.front().T_camera_board.rotation, v.T_camera_board.rotation));
   if (out.rotation_range_deg < o.min_rotation_deg)
-    throw InputError(where + "the camera turns only " + fmt(out.rotation_range_deg) + " degrees over the recording; at least " +
-                     fmt(o.min_rotation_deg, 0) + " are needed (tilt and turn it about all axes while filming the board)");
+    throw InputError(where + "the camera turns only " + fmt(out.rotation_range_deg) +
+                     " degrees over the recording; at least " + fmt(o.min_rotation_deg, 0) +
+                     " are needed (tilt and turn it about all axes while filming the board)");
   if (out.rotation_range_deg < 30)
     out.warnings.push_back("the camera turns only " + fmt(out.rotation_range_deg) +
                            " degrees; 45 or more about all axes gives a better calibration");
@@ -258,8 +260,8 @@ RigCalibrationResult calibrate_rig(const std::vector<BoardView>& views_in, const
                      " tracker samples fall between board views; record the tracker for the whole video");
   out.hand_eye = solve_hand_eye(sensor, board, o.hand_eye);
 
-  FitState state{out.hand_eye.T_sensor_camera, out.hand_eye.T_transmitter_board,
-                 nanos_to_seconds(out.correlation_offset), {}};
+  FitState state{
+      out.hand_eye.T_sensor_camera, out.hand_eye.T_transmitter_board, nanos_to_seconds(out.correlation_offset), {}};
   const RigModel model{&samples, &path, o.tracker_rotation_sigma_deg * kPi / 180.0, o.tracker_position_sigma_m};
   std::vector<double> r;
   if (o.refine) {
@@ -280,7 +282,8 @@ RigCalibrationResult calibrate_rig(const std::vector<BoardView>& views_in, const
       }
     }
     out.sigma_rotation_deg = std::sqrt(state.covariance.at<double>(0, 0) + state.covariance.at<double>(1, 1) +
-                                       state.covariance.at<double>(2, 2)) * 180.0 / kPi;
+                                       state.covariance.at<double>(2, 2)) *
+                             180.0 / kPi;
     out.sigma_translation_m = std::sqrt(state.covariance.at<double>(3, 3) + state.covariance.at<double>(4, 4) +
                                         state.covariance.at<double>(5, 5));
     out.sigma_time_offset_s = std::sqrt(state.covariance.at<double>(12, 12));

@@ -2,11 +2,11 @@
 
 #include <string>
 
+#include "lumar/base/error.h"
 #include "lumar/calib/board_pose.h"
 #include "lumar/capture/durable_file.h"
 #include "lumar/capture/recording_format.h"
 #include "lumar/capture/recording_reader.h"
-#include "lumar/base/error.h"
 #include "lumar/tracking/pose_conversion.h"
 #include "lumar/tracking/record_codec.h"
 #include "lumar/tracking/record_parser.h"
@@ -72,9 +72,9 @@ RigRecording load_rig_recording(const std::filesystem::path& dir, cv::Size inner
   while (frames->read(frame)) {
     if (out.frames++ % every != 0) continue;
     if (frame.image.cols != out.camera.width || frame.image.rows != out.camera.height)
-      throw InputError(dir.string() + ": frame " + std::to_string(frame.index) + " is " + size_text(frame.image.size()) +
-                       " but the camera calibration is " + std::to_string(out.camera.width) + "x" +
-                       std::to_string(out.camera.height));
+      throw InputError(dir.string() + ": frame " + std::to_string(frame.index) + " is " +
+                       size_text(frame.image.size()) + " but the camera calibration is " +
+                       std::to_string(out.camera.width) + "x" + std::to_string(out.camera.height));
     // Adaptive thresholding only once the board size has proved right: a wrong --board
     // would otherwise cost a quarter of a second per frame.
     if (auto pose = find_board_pose(frame.image, inner_corners, square_size_m, out.camera, !out.views.empty()))

@@ -102,8 +102,8 @@ int distinct_orientations(const std::vector<cv::Mat>& rvecs, double separation_d
     cv::Matx33d R;
     cv::Rodrigues(r, R);
     const cv::Vec3d normal(R(0, 2), R(1, 2), R(2, 2));
-    const bool seen = std::any_of(classes.begin(), classes.end(),
-                                  [&](const cv::Vec3d& n) { return n.dot(normal) > cos_sep; });
+    const bool seen =
+        std::any_of(classes.begin(), classes.end(), [&](const cv::Vec3d& n) { return n.dot(normal) > cos_sep; });
     if (!seen) classes.push_back(normal);
   }
   return int(classes.size());

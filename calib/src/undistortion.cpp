@@ -25,8 +25,8 @@ CameraIntrinsics pinhole_from_matrix(const CameraIntrinsics& like, const cv::Mat
 
 UndistortionMaps make_undistortion_maps(const CameraIntrinsics& distorted, UndistortedCamera output) {
   if (!distorted.is_valid())
-    throw InputError("camera intrinsics are invalid (size " + size_text(distorted.width, distorted.height) +
-                     ", fx " + std::to_string(distorted.fx) + ", fy " + std::to_string(distorted.fy) +
+    throw InputError("camera intrinsics are invalid (size " + size_text(distorted.width, distorted.height) + ", fx " +
+                     std::to_string(distorted.fx) + ", fy " + std::to_string(distorted.fy) +
                      "); recalibrate the camera");
   const cv::Size size(distorted.width, distorted.height);
   const cv::Mat K(distorted.camera_matrix());
@@ -57,8 +57,8 @@ cv::Mat distort_image(const cv::Mat& pinhole_image, const CameraIntrinsics& pinh
   if (!pinhole_camera.is_valid() || !distorted_camera.is_valid())
     throw InputError("distort_image: camera intrinsics are invalid; recalibrate the camera");
   if (pinhole_image.cols != pinhole_camera.width || pinhole_image.rows != pinhole_camera.height)
-    throw InputError("pinhole image is " + size_text(pinhole_image.cols, pinhole_image.rows) +
-                     " but its camera is " + size_text(pinhole_camera.width, pinhole_camera.height));
+    throw InputError("pinhole image is " + size_text(pinhole_image.cols, pinhole_image.rows) + " but its camera is " +
+                     size_text(pinhole_camera.width, pinhole_camera.height));
   const int w = distorted_camera.width, h = distorted_camera.height;
   cv::Mat pixels(w * h, 1, CV_64FC2);
   for (int v = 0; v < h; ++v)

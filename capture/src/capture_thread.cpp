@@ -3,18 +3,23 @@
 #include <chrono>
 #include <cmath>
 
-#include "lumar/capture/v4l2_source.h"
 #include "lumar/base/error.h"
+#include "lumar/capture/v4l2_source.h"
 
 namespace lumar::capture {
 
 const char* to_string(CaptureEnd end) {
   switch (end) {
-    case CaptureEnd::Running: return "running";
-    case CaptureEnd::EndOfStream: return "end of stream";
-    case CaptureEnd::Stopped: return "stopped";
-    case CaptureEnd::Vanished: return "camera vanished";
-    case CaptureEnd::Failed: return "failed";
+    case CaptureEnd::Running:
+      return "running";
+    case CaptureEnd::EndOfStream:
+      return "end of stream";
+    case CaptureEnd::Stopped:
+      return "stopped";
+    case CaptureEnd::Vanished:
+      return "camera vanished";
+    case CaptureEnd::Failed:
+      return "failed";
   }
   return "?";
 }

@@ -61,19 +61,17 @@ double Row::real(std::size_t column) const {
   double value = 0;
   const auto r = std::from_chars(f.data(), f.data() + f.size(), value);
   if (r.ec != std::errc() || r.ptr != f.data() + f.size() || f.empty() || !std::isfinite(value))
-    fail("field " + std::to_string(column + 1) + " \"" + std::string(f) +
-         "\" is not a finite number");
+    fail("field " + std::to_string(column + 1) + " \"" + std::string(f) + "\" is not a finite number");
   return value;
 }
 
-void for_each_row(const std::filesystem::path& path, std::string_view header,
-                  std::size_t columns, const std::function<void(const Row&)>& fn) {
+void for_each_row(const std::filesystem::path& path, std::string_view header, std::size_t columns,
+                  const std::function<void(const Row&)>& fn) {
   const std::string text = read_file(path);
   std::string_view rest = text;
   std::size_t line = 0;
   std::vector<std::string_view> fields;
-  for (std::size_t end; (end = rest.find('\n')) != std::string_view::npos;
-       rest.remove_prefix(end + 1)) {
+  for (std::size_t end; (end = rest.find('\n')) != std::string_view::npos; rest.remove_prefix(end + 1)) {
     const std::string_view content = rest.substr(0, end);
     ++line;
     if (line == 1) {
@@ -91,8 +89,7 @@ void for_each_row(const std::filesystem::path& path, std::string_view header,
     }
     const Row row(path, line, fields);
     if (fields.size() != columns)
-      row.fail("expected " + std::to_string(columns) + " fields, found " +
-               std::to_string(fields.size()));
+      row.fail("expected " + std::to_string(columns) + " fields, found " + std::to_string(fields.size()));
     fn(row);
   }
   // Whatever is left has no '\n': a torn final write, ignored on purpose.

@@ -38,7 +38,7 @@ class Row {
 // Calls `fn` for each complete row after the header. Throws InputError naming the
 // file and line for a wrong header or a row with a wrong field count. A file with
 // no complete line (not even the header) has no rows.
-void for_each_row(const std::filesystem::path& path, std::string_view header,
-                  std::size_t columns, const std::function<void(const Row&)>& fn);
+void for_each_row(const std::filesystem::path& path, std::string_view header, std::size_t columns,
+                  const std::function<void(const Row&)>& fn);
 
 }  // namespace lumar::capture::csv

@@ -79,7 +79,8 @@ bool natural_less(const std::string& a, const std::string& b) {
 
 ImageSequenceSource::ImageSequenceSource(ImageSequenceSettings settings) : settings_(std::move(settings)) {
   const std::string& pattern = settings_.pattern;
-  if (pattern.empty()) throw InputError("images: no folder or glob given; use e.g. images:shots/ or 'images:shots/*.png'");
+  if (pattern.empty())
+    throw InputError("images: no folder or glob given; use e.g. images:shots/ or 'images:shots/*.png'");
   if (settings_.timestamps.empty()) {
     if (!(settings_.fps > 0) || !std::isfinite(settings_.fps))
       throw InputError(pattern + ": an image sequence needs a timestamp table or a frame rate (--fps)");
@@ -117,8 +118,7 @@ ImageSequenceSource::ImageSequenceSource(ImageSequenceSettings settings) : setti
       if (!times_.empty() && t <= times_.back())
         throw InputError(where + "time " + std::to_string(t) + " does not increase; the rows must be in time order");
       const fs::path file = folder / row.substr(0, comma);
-      if (std::error_code e; !fs::is_regular_file(file, e))
-        throw InputError(where + "no such image " + file.string());
+      if (std::error_code e; !fs::is_regular_file(file, e)) throw InputError(where + "no such image " + file.string());
       files_.push_back(file);
       times_.push_back(t);
     }
@@ -130,8 +130,7 @@ ImageSequenceSource::ImageSequenceSource(ImageSequenceSettings settings) : setti
 
 cv::Mat ImageSequenceSource::decode(std::size_t i) const {
   cv::Mat img = cv::imread(files_[i].string(), cv::IMREAD_COLOR);  // BGR8, whatever the file holds
-  if (img.empty())
-    throw InputError(files_[i].string() + ": cannot decode this image; it is corrupt or not an image");
+  if (img.empty()) throw InputError(files_[i].string() + ": cannot decode this image; it is corrupt or not an image");
   return img;
 }
 
@@ -141,8 +140,8 @@ bool ImageSequenceSource::read(Frame& frame) {
   cv::Mat img = decode(i);
   if (img.size() != size_)
     throw InputError(files_[i].string() + ": is " + std::to_string(img.cols) + "x" + std::to_string(img.rows) +
-                     ", the sequence started at " + std::to_string(size_.width) + "x" +
-                     std::to_string(size_.height) + "; every image must have the same size");
+                     ", the sequence started at " + std::to_string(size_.width) + "x" + std::to_string(size_.height) +
+                     "; every image must have the same size");
   frame.image = img;
   frame.time = times_[i];
   frame.index = std::int64_t(i);

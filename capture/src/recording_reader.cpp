@@ -3,8 +3,8 @@
 #include <fstream>
 
 #include "csv_text.h"
-#include "lumar/capture/recording_source.h"
 #include "lumar/base/error.h"
+#include "lumar/capture/recording_source.h"
 #include "lumar/capture/tracker_raw.h"
 
 namespace lumar::capture {
@@ -15,15 +15,13 @@ namespace {
 Pose pose_from_row(const csv::Row& row, std::size_t first) {
   Pose p;
   p.translation = {row.real(first), row.real(first + 1), row.real(first + 2)};
-  p.rotation = glm::dquat(row.real(first + 3), row.real(first + 4), row.real(first + 5),
-                          row.real(first + 6));
+  p.rotation = glm::dquat(row.real(first + 3), row.real(first + 4), row.real(first + 5), row.real(first + 6));
   return p;
 }
 
 RecordingSettings video_from_session(const nlohmann::json& session, const fs::path& file) {
   const auto bad = [&](const std::string& what) -> InputError {
-    return InputError(file.string() + ": \"video\" " + what +
-                      "; the recording was not written by Lumar or is damaged");
+    return InputError(file.string() + ": \"video\" " + what + "; the recording was not written by Lumar or is damaged");
   };
   const auto it = session.find("video");
   if (it == session.end() || !it->is_object()) throw bad("is missing");
@@ -45,8 +43,7 @@ RecordingSettings video_from_session(const nlohmann::json& session, const fs::pa
 
 RecordingReader::RecordingReader(const fs::path& dir) : dir_(dir) {
   std::error_code ec;
-  if (!fs::is_directory(dir, ec))
-    throw InputError(dir.string() + ": no such recording directory; check the path");
+  if (!fs::is_directory(dir, ec)) throw InputError(dir.string() + ": no such recording directory; check the path");
 
   const fs::path session_file = dir / kSessionFile;
   if (!fs::exists(session_file, ec))
@@ -56,36 +53,32 @@ RecordingReader::RecordingReader(const fs::path& dir) : dir_(dir) {
   try {
     session_ = nlohmann::json::parse(text);
   } catch (const nlohmann::json::parse_error& e) {
-    throw InputError(session_file.string() + ": malformed JSON (" + e.what() +
-                     "); repair it by hand or restore it");
+    throw InputError(session_file.string() + ": malformed JSON (" + e.what() + "); repair it by hand or restore it");
   }
   if (!session_.is_object())
     throw InputError(session_file.string() + ": malformed session (not a JSON object); repair it" +
                      " by hand or restore it");
   const auto format = session_.find("format");
-  if (format == session_.end() || !format->is_string() ||
-      format->get<std::string>() != kRecordingFormat)
+  if (format == session_.end() || !format->is_string() || format->get<std::string>() != kRecordingFormat)
     throw InputError(session_file.string() + ": \"format\" is not \"" + kRecordingFormat +
                      "\"; this is not a Lumar recording");
   const auto version = session_.find("version");
-  if (version == session_.end() || !version->is_number_integer() ||
-      version->get<int>() != kRecordingVersion)
+  if (version == session_.end() || !version->is_number_integer() || version->get<int>() != kRecordingVersion)
     throw InputError(session_file.string() + ": unsupported recording version " +
-                     (version == session_.end() ? "(none)" : version->dump()) +
-                     "; this Lumar reads version " + std::to_string(kRecordingVersion));
+                     (version == session_.end() ? "(none)" : version->dump()) + "; this Lumar reads version " +
+                     std::to_string(kRecordingVersion));
   video_ = video_from_session(session_, session_file);
 
   // The writer appends whole closed segments in order; anything else is damage.
   csv::for_each_row(dir / kFramesFile, kFramesHeader, 4, [&](const csv::Row& row) {
     FrameEntry e{row.integer(0), row.integer(1), row.small_integer(2), row.small_integer(3)};
     const FrameEntry* prev = frames_.empty() ? nullptr : &frames_.back();
-    const bool continues = prev && e.segment == prev->segment &&
-                           e.segment_frame == prev->segment_frame + 1 &&
+    const bool continues = prev && e.segment == prev->segment && e.segment_frame == prev->segment_frame + 1 &&
                            e.segment_frame < video_.frames_per_segment;
     const bool starts = e.segment_frame == 0 && e.segment == (prev ? prev->segment + 1 : 0);
     if (!continues && !starts)
-      row.fail("segment " + std::to_string(e.segment) + " frame " +
-               std::to_string(e.segment_frame) + " is out of sequence");
+      row.fail("segment " + std::to_string(e.segment) + " frame " + std::to_string(e.segment_frame) +
+               " is out of sequence");
     frames_.push_back(e);
   });
 }
@@ -95,9 +88,7 @@ bool RecordingReader::complete() const {
   return it != session_.end() && it->is_boolean() && it->get<bool>();
 }
 
-fs::path RecordingReader::segment_file(int segment) const {
-  return segment_path(dir_, video_.codec, segment);
-}
+fs::path RecordingReader::segment_file(int segment) const { return segment_path(dir_, video_.codec, segment); }
 
 std::vector<tracking::ByteChunk> RecordingReader::tracker_chunks(std::size_t* ignored_bytes) const {
   const std::string data = csv::read_file(dir_ / kTrackerFile);
@@ -123,8 +114,6 @@ std::vector<TruthEntry> RecordingReader::truth() const {
   return entries;
 }
 
-std::unique_ptr<FrameSource> RecordingReader::open_frames() const {
-  return std::make_unique<RecordingSource>(*this);
-}
+std::unique_ptr<FrameSource> RecordingReader::open_frames() const { return std::make_unique<RecordingSource>(*this); }
 
 }  // namespace lumar::capture

@@ -1,8 +1,8 @@
 #include "lumar/capture/recording_replay.h"
 
 #include "lumar/base/error.h"
-#include "lumar/tracking/record_parser.h"
 #include "lumar/tracking/pose_conversion.h"
+#include "lumar/tracking/record_parser.h"
 #include "lumar/tracking/timestamping.h"
 
 namespace lumar::capture {

@@ -1,7 +1,7 @@
 #include "lumar/capture/recording_source.h"
 
-#include "lumar/capture/recording_reader.h"
 #include "lumar/base/error.h"
+#include "lumar/capture/recording_reader.h"
 
 namespace lumar::capture {
 
@@ -9,8 +9,8 @@ RecordingSource::RecordingSource(const RecordingReader& recording)
     : dir_(recording.directory()), video_(recording.video()), frames_(recording.frames()) {}
 
 void RecordingSource::fail_truncated() const {
-  throw InputError(segment_file_.string() + ": truncated or corrupt video (decoded " +
-                   std::to_string(decoded_) + " of " + std::to_string(segment_rows_) +
+  throw InputError(segment_file_.string() + ": truncated or corrupt video (decoded " + std::to_string(decoded_) +
+                   " of " + std::to_string(segment_rows_) +
                    " frames); the recording is damaged, replay only the frames before it");
 }
 
@@ -19,8 +19,7 @@ void RecordingSource::open_segment(int segment) {
   segment_ = segment;
   segment_file_ = segment_path(dir_, video_.codec, segment);
   segment_rows_ = 0;
-  for (std::size_t i = next_; i < frames_.size() && frames_[i].segment == segment; ++i)
-    ++segment_rows_;
+  for (std::size_t i = next_; i < frames_.size() && frames_[i].segment == segment; ++i) ++segment_rows_;
   decoded_ = 0;
   // FFmpeg for both codecs. OpenCV's own MJPEG reader converts colour slightly more
   // exactly (mean error 0.49 levels at quality 95, against 0.83), but OpenCV 4.6's MJPEG
@@ -28,8 +27,7 @@ void RecordingSource::open_segment(int segment) {
   // prints "Corrupt JPEG data" on stderr for each; FFmpeg decodes them silently.
   const int api = cv::CAP_FFMPEG;
   std::error_code ec;
-  if (!std::filesystem::exists(segment_file_, ec) || !capture_.open(segment_file_.string(), api))
-    fail_truncated();
+  if (!std::filesystem::exists(segment_file_, ec) || !capture_.open(segment_file_.string(), api)) fail_truncated();
 }
 
 bool RecordingSource::read(Frame& frame) {
@@ -43,9 +41,8 @@ bool RecordingSource::read(Frame& frame) {
   if (!capture_.read(image) || image.empty()) fail_truncated();
   ++decoded_;
   if (image.size() != video_.size || image.type() != CV_8UC3)
-    throw InputError(segment_file_.string() + ": frame " + std::to_string(decoded_ - 1) +
-                     " decodes as " + std::to_string(image.cols) + "x" +
-                     std::to_string(image.rows) + ", but session.json says " +
+    throw InputError(segment_file_.string() + ": frame " + std::to_string(decoded_ - 1) + " decodes as " +
+                     std::to_string(image.cols) + "x" + std::to_string(image.rows) + ", but session.json says " +
                      std::to_string(video_.size.width) + "x" + std::to_string(video_.size.height) +
                      " BGR; the recording is damaged");
   frame.image = image;

@@ -14,8 +14,8 @@
 #include <vector>
 
 #include "csv_text.h"
-#include "lumar/capture/durable_file.h"
 #include "lumar/base/error.h"
+#include "lumar/capture/durable_file.h"
 #include "lumar/capture/tracker_raw.h"
 
 namespace lumar::capture {
@@ -35,8 +35,8 @@ struct SyncedLog {
 };
 
 void append_pose_fields(std::string& out, const Pose& p) {
-  for (double v : {p.translation.x, p.translation.y, p.translation.z, p.rotation.w, p.rotation.x,
-                   p.rotation.y, p.rotation.z}) {
+  for (double v :
+       {p.translation.x, p.translation.y, p.translation.z, p.rotation.w, p.rotation.x, p.rotation.y, p.rotation.z}) {
     out.push_back(',');
     csv::append_double(out, v);
   }
@@ -50,8 +50,8 @@ void check_avi_complete(const fs::path& file, std::uintmax_t size) {
   unsigned char h[8] = {};
   const bool read = f && std::fread(h, 1, 8, f) == 8;
   if (f) std::fclose(f);
-  const std::uint64_t riff = std::uint64_t(h[4]) | std::uint64_t(h[5]) << 8 | std::uint64_t(h[6]) << 16 |
-                             std::uint64_t(h[7]) << 24;
+  const std::uint64_t riff =
+      std::uint64_t(h[4]) | std::uint64_t(h[5]) << 8 | std::uint64_t(h[6]) << 16 | std::uint64_t(h[7]) << 24;
   if (!read || std::memcmp(h, "RIFF", 4) != 0 || riff == 0 || riff + 8 > size)
     throw RuntimeError(file.string() + ": the video segment was cut short (" + std::to_string(size) +
                        " bytes written); the disk is full or a file size limit was hit");
@@ -139,16 +139,14 @@ struct RecordingWriter::Impl {
     }
   }
 
-  void write_session() {
-    write_file_atomically(dir / kSessionFile, session.dump(2) + "\n");
-  }
+  void write_session() { write_file_atomically(dir / kSessionFile, session.dump(2) + "\n"); }
 
   void open_segment() {
     const fs::path path = partial_segment_path(dir, settings.codec, segment_number);
     bool ok = false;
     if (settings.codec == "mjpeg") {
-      ok = segment.open(path.string(), cv::CAP_OPENCV_MJPEG,
-                        cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), settings.fps, settings.size);
+      ok = segment.open(path.string(), cv::CAP_OPENCV_MJPEG, cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), settings.fps,
+                        settings.size);
       // OpenCV 4.6's MJPEG writer ignores a quality given to open(); set() works.
       // Its encoder also drops the last 4 bytes of about 1 frame in 32 (opencv#24171,
       // fixed in 4.9): that frame's bottom-right 16x16 block decodes 2-3 levels off
@@ -157,8 +155,8 @@ struct RecordingWriter::Impl {
         throw RuntimeError(path.string() + ": OpenCV's MJPEG writer refused quality " +
                            std::to_string(settings.quality));
     } else {
-      ok = segment.open(path.string(), cv::CAP_FFMPEG, cv::VideoWriter::fourcc('F', 'F', 'V', '1'),
-                        settings.fps, settings.size);
+      ok = segment.open(path.string(), cv::CAP_FFMPEG, cv::VideoWriter::fourcc('F', 'F', 'V', '1'), settings.fps,
+                        settings.size);
     }
     if (!ok)
       throw RuntimeError(path.string() + ": OpenCV cannot open a " + settings.codec +
@@ -176,14 +174,11 @@ struct RecordingWriter::Impl {
     const fs::path final_path = segment_path(dir, settings.codec, segment_number);
     std::error_code ec;
     const auto size = fs::file_size(partial, ec);
-    if (size == 0 || ec)
-      throw RuntimeError(partial.string() + ": the video writer left no data; check free space");
+    if (size == 0 || ec) throw RuntimeError(partial.string() + ": the video writer left no data; check free space");
     if (settings.codec == "mjpeg") check_avi_complete(partial, size);
     fsync_path(partial);
     fs::rename(partial, final_path, ec);
-    if (ec)
-      throw RuntimeError(final_path.string() + ": cannot rename the closed segment (" +
-                         ec.message() + ")");
+    if (ec) throw RuntimeError(final_path.string() + ": cannot rename the closed segment (" + ec.message() + ")");
     fsync_path(dir / kVideoDir);
 
     std::string rows;
@@ -225,8 +220,7 @@ struct RecordingWriter::Impl {
   }
 };
 
-RecordingWriter::RecordingWriter(const fs::path& dir, nlohmann::json session,
-                                 RecordingSettings settings)
+RecordingWriter::RecordingWriter(const fs::path& dir, nlohmann::json session, RecordingSettings settings)
     : impl_(std::make_unique<Impl>()) {
   Impl& w = *impl_;
   w.dir = dir;
@@ -240,11 +234,9 @@ RecordingWriter::RecordingWriter(const fs::path& dir, nlohmann::json session,
   std::error_code ec;
   if (fs::exists(dir, ec)) {
     if (!fs::is_directory(dir, ec))
-      throw InputError(dir.string() +
-                       ": exists and is not a directory; choose a new recording directory");
+      throw InputError(dir.string() + ": exists and is not a directory; choose a new recording directory");
     if (!fs::is_empty(dir, ec))
-      throw InputError(dir.string() +
-                       ": directory is not empty; choose a new recording directory");
+      throw InputError(dir.string() + ": directory is not empty; choose a new recording directory");
   }
   fs::create_directories(dir / kVideoDir, ec);
   if (ec)
@@ -298,18 +290,16 @@ void RecordingWriter::add_frame(const Frame& frame) {
   w.check_usable();
   const cv::Mat& img = frame.image;
   if (img.empty() || img.type() != CV_8UC3 || img.size() != w.settings.size)
-    throw InputError(w.what() + ": frame " + std::to_string(frame.index) + " is " +
-                     std::to_string(img.cols) + "x" + std::to_string(img.rows) + " with " +
-                     std::to_string(img.channels()) + " channels; the recording takes 8-bit BGR " +
-                     std::to_string(w.settings.size.width) + "x" +
+    throw InputError(w.what() + ": frame " + std::to_string(frame.index) + " is " + std::to_string(img.cols) + "x" +
+                     std::to_string(img.rows) + " with " + std::to_string(img.channels()) +
+                     " channels; the recording takes 8-bit BGR " + std::to_string(w.settings.size.width) + "x" +
                      std::to_string(w.settings.size.height));
   std::lock_guard lock(w.video_mutex);
   if (w.closed) throw RuntimeError(w.what() + ": already closed; frames added after close() are lost");
   w.guarded([&] {
     if (!w.segment_open) w.open_segment();
     w.segment.write(img);
-    w.segment_rows.push_back(
-        {frame.index, frame.time, w.segment_number, int(w.segment_rows.size())});
+    w.segment_rows.push_back({frame.index, frame.time, w.segment_number, int(w.segment_rows.size())});
     if (int(w.segment_rows.size()) == w.settings.frames_per_segment) w.close_segment();
   });
 }
@@ -341,8 +331,7 @@ void RecordingWriter::add_truth(std::int64_t index, Nanos time, const Pose& T_wo
   Impl& w = *impl_;
   w.check_usable();
   if (!T_world_camera.is_finite())
-    throw InputError(w.what() + ": true pose of frame " + std::to_string(index) +
-                     " holds a non-finite number");
+    throw InputError(w.what() + ": true pose of frame " + std::to_string(index) + " holds a non-finite number");
   std::string row;
   csv::append_int(row, index);
   row.push_back(',');

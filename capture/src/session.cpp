@@ -11,15 +11,17 @@ using nlohmann::json;
 json session_to_json(const Session& s) {
   const CameraIntrinsics& c = s.camera;
   json j = s.extra;
-  j["camera"] = {{"width", c.width}, {"height", c.height}, {"fx", c.fx},       {"fy", c.fy},
-                 {"cx", c.cx},       {"cy", c.cy},         {"distortion", c.distortion}};
+  j["camera"] = {{"width", c.width}, {"height", c.height},        {"fx", c.fx}, {"fy", c.fy}, {"cx", c.cx},
+                 {"cy", c.cy},       {"distortion", c.distortion}};
   j["radiometry"] = {{"response", s.radiometry.response},
                      {"exposure", s.radiometry.exposure},
                      {"vignetting", {s.radiometry.vignetting_a, s.radiometry.vignetting_b}}};
-  j["tracker"] = {{"device", s.tracker.device},     {"encoding", s.tracker.encoding},
+  j["tracker"] = {{"device", s.tracker.device},
+                  {"encoding", s.tracker.encoding},
                   {"output_list", s.tracker.output_list},
                   {"units", s.tracker.centimetres ? "centimetres" : "inches"},
-                  {"baud", s.tracker.baud},         {"rate_hz", s.tracker.rate_hz},
+                  {"baud", s.tracker.baud},
+                  {"rate_hz", s.tracker.rate_hz},
                   {"station", s.tracker.station}};
   j["rig"] = {{"T_world_transmitter", tracking::pose_to_json(s.rig.T_world_transmitter)},
               {"T_sensor_camera", tracking::pose_to_json(s.rig.T_sensor_camera)},

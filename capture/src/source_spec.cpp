@@ -14,7 +14,8 @@ OpenedSource open_frame_source(const std::string& spec, const SourceOptions& opt
     throw InputError("--source '" + spec +
                      "' is not a source; use video:FILE, images:DIR_OR_GLOB, v4l2:/dev/videoN or recording:DIR");
   if (kind == "video") return {std::make_unique<VideoFileSource>(path), false};
-  if (kind == "images") return {std::make_unique<ImageSequenceSource>(ImageSequenceSettings{path, options.timestamps, options.fps}), false};
+  if (kind == "images")
+    return {std::make_unique<ImageSequenceSource>(ImageSequenceSettings{path, options.timestamps, options.fps}), false};
   if (kind == "recording") return {RecordingReader(path).open_frames(), false};
   if (kind == "v4l2") {
     V4l2Settings s = options.v4l2;

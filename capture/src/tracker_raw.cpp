@@ -5,8 +5,8 @@
 #include <cstdint>
 #include <limits>
 
-#include "lumar/capture/recording_format.h"
 #include "lumar/base/error.h"
+#include "lumar/capture/recording_format.h"
 
 namespace lumar::capture {
 namespace {
@@ -47,8 +47,7 @@ void append_tracker_chunk(std::string& out, const tracking::ByteChunk& chunk) {
   out.append(reinterpret_cast<const char*>(chunk.bytes.data()), chunk.bytes.size());
 }
 
-std::vector<tracking::ByteChunk> parse_tracker_chunks(std::string_view data,
-                                                      std::size_t* ignored_bytes) {
+std::vector<tracking::ByteChunk> parse_tracker_chunks(std::string_view data, std::size_t* ignored_bytes) {
   std::vector<tracking::ByteChunk> chunks;
   const auto* p = reinterpret_cast<const unsigned char*>(data.data());
   std::size_t pos = 0;

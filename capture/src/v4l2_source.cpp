@@ -93,8 +93,8 @@ void V4l2Source::fail_errno(const std::string& step) {
 }
 
 void V4l2Source::vanished() {
-  throw CameraVanished(settings_.path + ": the camera disappeared (unplugged?) after " +
-                       std::to_string(stats_.frames) + " frames; plug it back in and start again");
+  throw CameraVanished(settings_.path + ": the camera disappeared (unplugged?) after " + std::to_string(stats_.frames) +
+                       " frames; plug it back in and start again");
 }
 
 void V4l2Source::negotiate_format() {
@@ -146,11 +146,10 @@ void V4l2Source::negotiate_format() {
   format_.width = int(fmt.fmt.pix.width);
   format_.height = int(fmt.fmt.pix.height);
   format_.bytes_per_line = int(fmt.fmt.pix.bytesperline);
-  if (format_.width <= 0 || format_.height <= 0)
-    throw RuntimeError(path + ": the driver reports an empty frame size");
+  if (format_.width <= 0 || format_.height <= 0) throw RuntimeError(path + ": the driver reports an empty frame size");
   if (format_.width != settings_.width || format_.height != settings_.height)
-    spdlog::info("{}: asked for {}x{}, the camera gives {}x{}", path, settings_.width, settings_.height,
-                 format_.width, format_.height);
+    spdlog::info("{}: asked for {}x{}, the camera gives {}x{}", path, settings_.width, settings_.height, format_.width,
+                 format_.height);
 
   v4l2_streamparm parm{};
   parm.type = V4L2_BUF_TYPE_VIDEO_CAPTURE;
@@ -258,7 +257,8 @@ bool V4l2Source::convert(const Buffer& buffer, std::size_t bytes_used, cv::Mat& 
     return !bgr.empty() && bgr.cols == w && bgr.rows == h;
   }
   const int channels = f == "YUYV" ? 2 : 3;
-  const std::size_t stride = format_.bytes_per_line > 0 ? std::size_t(format_.bytes_per_line) : std::size_t(w) * channels;
+  const std::size_t stride =
+      format_.bytes_per_line > 0 ? std::size_t(format_.bytes_per_line) : std::size_t(w) * channels;
   if (stride < std::size_t(w) * channels || bytes_used < stride * std::size_t(h)) return false;
   const cv::Mat raw(h, w, channels == 2 ? CV_8UC2 : CV_8UC3, const_cast<std::uint8_t*>(data), stride);
   if (f == "YUYV")

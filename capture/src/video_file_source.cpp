@@ -19,8 +19,7 @@ VideoFileSource::VideoFileSource(const std::filesystem::path& path) : path_(path
                      " format (e.g. H.264 MP4 or MJPEG AVI)");
   const double fps = capture_.get(cv::CAP_PROP_FPS);
   fps_ = std::isfinite(fps) && fps > 0 ? fps : 0;
-  if (!decode(first_))
-    throw InputError(path.string() + ": no decodable video frame; the file is empty or corrupt");
+  if (!decode(first_)) throw InputError(path.string() + ": no decodable video frame; the file is empty or corrupt");
   first_pending_ = true;
   size_ = first_.image.size();
 }

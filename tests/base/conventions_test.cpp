@@ -19,9 +19,18 @@ glm::dquat random_rotation(std::mt19937& rng) {
   std::normal_distribution<double> n;
   return glm::normalize(glm::dquat(n(rng), n(rng), n(rng), n(rng)));
 }
-glm::dmat3 Rx(double a) { double c = cos(a), s = sin(a); return glm::transpose(glm::dmat3(1, 0, 0, 0, c, -s, 0, s, c)); }
-glm::dmat3 Ry(double a) { double c = cos(a), s = sin(a); return glm::transpose(glm::dmat3(c, 0, s, 0, 1, 0, -s, 0, c)); }
-glm::dmat3 Rz(double a) { double c = cos(a), s = sin(a); return glm::transpose(glm::dmat3(c, -s, 0, s, c, 0, 0, 0, 1)); }
+glm::dmat3 Rx(double a) {
+  double c = cos(a), s = sin(a);
+  return glm::transpose(glm::dmat3(1, 0, 0, 0, c, -s, 0, s, c));
+}
+glm::dmat3 Ry(double a) {
+  double c = cos(a), s = sin(a);
+  return glm::transpose(glm::dmat3(c, 0, s, 0, 1, 0, -s, 0, c));
+}
+glm::dmat3 Rz(double a) {
+  double c = cos(a), s = sin(a);
+  return glm::transpose(glm::dmat3(c, -s, 0, s, c, 0, 0, 0, 1));
+}
 double max_abs_diff(const glm::dmat3& a, const glm::dmat3& b) {
   double m = 0;
   for (int c = 0; c < 3; ++c)
@@ -124,8 +133,8 @@ TEST(Pose, InterpolationFollowsConstantAngularVelocity) {
 }
 
 TEST(Pose, RotationLogAndExpRoundTrip) {
-  for (const glm::dvec3 v : {glm::dvec3(0.3, -0.2, 0.5), glm::dvec3(0.1, -0.2, 0.3), glm::dvec3(3.0, 0, 0),
-                             glm::dvec3(1e-9, 0, 0)})
+  for (const glm::dvec3 v :
+       {glm::dvec3(0.3, -0.2, 0.5), glm::dvec3(0.1, -0.2, 0.3), glm::dvec3(3.0, 0, 0), glm::dvec3(1e-9, 0, 0)})
     EXPECT_LT(glm::length(rotation_log(rotation_exp(v)) - v), 1e-12);
   EXPECT_NEAR(rotation_angle_deg(rotation_exp(glm::dvec3(0, glm::radians(30.0), 0)), glm::dquat(1, 0, 0, 0)), 30.0,
               1e-9);

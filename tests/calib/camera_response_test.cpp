@@ -12,8 +12,8 @@
 #include <opencv2/imgproc.hpp>
 
 #include "lumar/base/color.h"
-#include "lumar/scene/envmap.h"
 #include "lumar/base/error.h"
+#include "lumar/scene/envmap.h"
 #include "test_paths.h"
 
 namespace lumar::calib {

@@ -3,8 +3,8 @@
 
 #include <cmath>
 
-#include "lumar/calib/lighting_adapter.h"
 #include "lumar/base/error.h"
+#include "lumar/calib/lighting_adapter.h"
 
 namespace lumar {
 namespace {

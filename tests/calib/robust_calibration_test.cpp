@@ -12,16 +12,17 @@
 #include <opencv2/imgcodecs.hpp>
 #include <random>
 
+#include "lumar/base/error.h"
 #include "lumar/calib/calibration_report.h"
 #include "lumar/calib/checkerboard_calibration.h"
-#include "lumar/base/error.h"
 #include "test_paths.h"
 
 namespace lumar::calib {
 namespace {
 
 const BoardViews& real_views() {
-  static const BoardViews views = detect_checkerboard_views(load_board_images(test::checkerboard_images()), {9, 6}, 0.025);
+  static const BoardViews views =
+      detect_checkerboard_views(load_board_images(test::checkerboard_images()), {9, 6}, 0.025);
   return views;
 }
 
@@ -208,9 +209,10 @@ TEST(RobustCalibration, SyntheticBadViewIsRejectedAndTruthRecovered) {
   ASSERT_EQ(r.rejected.size(), 1u);
   EXPECT_EQ(r.rejected[0].name, "view7");
   const CameraIntrinsics& c = r.camera.intrinsics;
-  std::printf("[ measured ] synthetic: RMS %.4f -> %.4f px; fx %.3f ± %.3f (truth 600) cx %.3f ± %.3f (truth 322); "
-              "held-out %.4f px\n",
-              r.initial_rms, r.camera.avg_reprojection_error, c.fx, r.std_dev[0], c.cx, r.std_dev[2], r.holdout_rms);
+  std::printf(
+      "[ measured ] synthetic: RMS %.4f -> %.4f px; fx %.3f ± %.3f (truth 600) cx %.3f ± %.3f (truth 322); "
+      "held-out %.4f px\n",
+      r.initial_rms, r.camera.avg_reprojection_error, c.fx, r.std_dev[0], c.cx, r.std_dev[2], r.holdout_rms);
   // calibrateCamera's RMS is per corner (2-D), so noise of 0.2 px per axis gives
   // 0.2 * sqrt(2) shrunk by the parameters fitted: 9 intrinsics + 6 per view, out of
   // 2 residuals per corner. Its sampling spread is ~0.005 px.

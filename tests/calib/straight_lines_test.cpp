@@ -22,12 +22,12 @@ namespace {
 // A family of parallel lines in normalized image coordinates (x/z, y/z):
 // x cos(angle) + y sin(angle) = k * spacing.
 struct LineFamily {
-  double angle_deg;   // direction of the lines' normal from the x axis
-  bool transposed;    // measure along columns (for near-horizontal lines)
+  double angle_deg;  // direction of the lines' normal from the x axis
+  bool transposed;   // measure along columns (for near-horizontal lines)
 };
 
-constexpr double kSpacing = 0.1;         // normalized units: ~54 px at the webcam's focal length
-constexpr double kSigmaPixels = 1.5;     // line profile at the webcam's focal length
+constexpr double kSpacing = 0.1;      // normalized units: ~54 px at the webcam's focal length
+constexpr double kSigmaPixels = 1.5;  // line profile at the webcam's focal length
 
 // Anti-aliased by construction: each pixel is the Gaussian of its distance to the
 // nearest line, so no pixel grid leaks into the line's position.
@@ -121,16 +121,18 @@ Straightness measure(const cv::Mat& image, const cv::Mat& valid, bool transposed
 
 const char* mode_name(UndistortedCamera mode) {
   switch (mode) {
-    case UndistortedCamera::SameMatrix: return "SameMatrix";
-    case UndistortedCamera::CropToValid: return "CropToValid";
-    case UndistortedCamera::KeepAll: return "KeepAll";
+    case UndistortedCamera::SameMatrix:
+      return "SameMatrix";
+    case UndistortedCamera::CropToValid:
+      return "CropToValid";
+    case UndistortedCamera::KeepAll:
+      return "KeepAll";
   }
   return "?";
 }
 
 TEST(StraightLines, UndistortedImageOfStraightLinesHasStraightLines) {
-  const CameraIntrinsics camera =
-      load_camera_file(test::source_dir() / "data/camera/webcam-640x480.yml").intrinsics;
+  const CameraIntrinsics camera = load_camera_file(test::source_dir() / "data/camera/webcam-640x480.yml").intrinsics;
   ASSERT_TRUE(camera.has_distortion());
 
   // Pinhole image of the scene: twice the webcam's resolution at its centre, wide enough

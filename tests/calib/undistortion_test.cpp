@@ -8,16 +8,14 @@
 #include <cstdio>
 #include <opencv2/calib3d.hpp>
 
-#include "lumar/calib/camera_file.h"
 #include "lumar/base/error.h"
+#include "lumar/calib/camera_file.h"
 #include "test_paths.h"
 
 namespace lumar::calib {
 namespace {
 
-CameraIntrinsics webcam() {
-  return load_camera_file(test::source_dir() / "data/camera/webcam-640x480.yml").intrinsics;
-}
+CameraIntrinsics webcam() { return load_camera_file(test::source_dir() / "data/camera/webcam-640x480.yml").intrinsics; }
 
 // Pixel of `camera` where a pinhole pixel (u, v) of `pinhole` lands, by the forward model.
 cv::Point2d undistorted_to_distorted(const CameraIntrinsics& camera, const CameraIntrinsics& pinhole, double u,
@@ -40,7 +38,8 @@ double sample(const cv::Mat& image, double x, double y) {
   const int x0 = int(std::floor(x)), y0 = int(std::floor(y));
   const double fx = x - x0, fy = y - y0;
   const auto at = [&](int c, int r) { return double(image.at<float>(r, c)); };
-  return (1 - fy) * ((1 - fx) * at(x0, y0) + fx * at(x0 + 1, y0)) + fy * ((1 - fx) * at(x0, y0 + 1) + fx * at(x0 + 1, y0 + 1));
+  return (1 - fy) * ((1 - fx) * at(x0, y0) + fx * at(x0 + 1, y0)) +
+         fy * ((1 - fx) * at(x0, y0 + 1) + fx * at(x0 + 1, y0 + 1));
 }
 
 // A smooth test pattern, in units of the image it is drawn for (scale = pixels per base pixel).
@@ -76,7 +75,8 @@ TEST(Undistortion, MapsAgreeWithTheLensModelAndOpenCV) {
         const cv::Point2d source(maps.map_x.at<float>(v, u), maps.map_y.at<float>(v, u));
         worst_forward = std::max(worst_forward, cv::norm(source - undistorted_to_distorted(camera, maps.output, u, v)));
         if (source.x < 0 || source.y < 0 || source.x > 639 || source.y > 479) continue;
-        worst_inverse = std::max(worst_inverse, cv::norm(precise_undistort(camera, maps.output, source) - cv::Point2d(u, v)));
+        worst_inverse =
+            std::max(worst_inverse, cv::norm(precise_undistort(camera, maps.output, source) - cv::Point2d(u, v)));
       }
     EXPECT_LE(worst_forward, 0.01) << int(mode);
     EXPECT_LE(worst_inverse, 0.01) << int(mode);
@@ -101,14 +101,16 @@ TEST(Undistortion, CropAndKeepAllOutputsDoWhatTheySay) {
   double lo_x = 1e9, hi_x = -1e9, lo_y = 1e9, hi_y = -1e9;
   cv::minMaxLoc(crop.map_x, &lo_x, &hi_x);
   cv::minMaxLoc(crop.map_y, &lo_y, &hi_y);
-  std::printf("[ measured ] CropToValid looks at x %.3f..%.3f, y %.3f..%.3f of a 640x480 image\n", lo_x, hi_x, lo_y, hi_y);
+  std::printf("[ measured ] CropToValid looks at x %.3f..%.3f, y %.3f..%.3f of a 640x480 image\n", lo_x, hi_x, lo_y,
+              hi_y);
   EXPECT_GE(lo_x, -1.5);
   EXPECT_LE(hi_x, 640.5);
   EXPECT_GE(lo_y, -1.5);
   EXPECT_LE(hi_y, 480.5);
   // KeepAll: every input corner lands inside the output image.
   const UndistortionMaps all = make_undistortion_maps(camera, UndistortedCamera::KeepAll);
-  for (const cv::Point2d corner : {cv::Point2d(0, 0), cv::Point2d(639, 0), cv::Point2d(0, 479), cv::Point2d(639, 479)}) {
+  for (const cv::Point2d corner :
+       {cv::Point2d(0, 0), cv::Point2d(639, 0), cv::Point2d(0, 479), cv::Point2d(639, 479)}) {
     const cv::Point2d p = precise_undistort(camera, all.output, corner);
     EXPECT_GE(p.x, -1.0);
     EXPECT_LE(p.x, 640.0);

@@ -8,9 +8,9 @@
 #include <cstdio>
 #include <opencv2/imgproc.hpp>
 
-#include "lumar/calib/camera_response.h"
 #include "lumar/base/color.h"
 #include "lumar/base/error.h"
+#include "lumar/calib/camera_response.h"
 
 namespace lumar::calib {
 namespace {

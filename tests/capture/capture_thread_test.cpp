@@ -104,7 +104,8 @@ TEST(CaptureThread, StopEndsAThreadBlockedOnAFullQueue) {
 TEST(CaptureThread, ASourceErrorEndsTheThreadWithItsMessage) {
   const auto dir = test::scratch_dir("capture_thread_error");
   test::RemoveOnSuccess cleanup{dir};
-  for (int i = 0; i < 3; ++i) cv::imwrite((dir / ("f" + std::to_string(i) + ".png")).string(), test::numbered_image(i, {32, 24}));
+  for (int i = 0; i < 3; ++i)
+    cv::imwrite((dir / ("f" + std::to_string(i) + ".png")).string(), test::numbered_image(i, {32, 24}));
   std::ofstream(dir / "f3.png") << "torn";
   FrameQueue queue(8, QueuePolicy::KeepAll);
   CaptureThread thread(std::make_unique<ImageSequenceSource>(ImageSequenceSettings{dir.string(), {}, 10}), queue);

@@ -27,8 +27,8 @@ Pose true_sensor(Nanos t) {
   const double s = nanos_to_seconds(t), w = 2 * kPi * 0.5;
   Pose p;
   p.translation = {0.3 * std::cos(w * s), 0.2 * std::sin(w * s), 0.4 + 0.05 * std::sin(2 * w * s)};
-  p.rotation = axis_angle_deg(glm::normalize(glm::dvec3(1, 0.5, 0.2)), 40 * std::sin(w * s)) *
-               axis_angle_deg({0, 0, 1}, 30 * s);
+  p.rotation =
+      axis_angle_deg(glm::normalize(glm::dvec3(1, 0.5, 0.2)), 40 * std::sin(w * s)) * axis_angle_deg({0, 0, 1}, 30 * s);
   return p;
 }
 
@@ -95,8 +95,7 @@ TEST(FramePosePairing, MatchesTruthWithinTheInterpolationErrorAtAKnownLatency) {
     // interpolated the same way. That is all a 60 Hz tracker can know.
     const Nanos k = Nanos(std::floor(nanos_to_seconds(t) * rate));
     const Nanos t0 = std::llround(double(k) * 1e9 / rate), t1 = std::llround(double(k + 1) * 1e9 / rate);
-    const Pose interpolated =
-        interpolate(true_sensor(t0), true_sensor(t1), double(t - t0) / double(t1 - t0));
+    const Pose interpolated = interpolate(true_sensor(t0), true_sensor(t1), double(t - t0) / double(t1 - t0));
     const Errors ei = error(rig.camera_pose(interpolated), truth);
 
     // Plus the record's quantisation: 0.01 in per axis, 0.01 deg per Euler angle.
@@ -117,10 +116,11 @@ TEST(FramePosePairing, MatchesTruthWithinTheInterpolationErrorAtAKnownLatency) {
   // The check can fail: forgetting the latency breaks both bounds by far.
   EXPECT_GT(worst_stale.position_m, 10 * (worst_interpolation.position_m + 0.30e-3));
   EXPECT_GT(worst_stale.rotation_deg, 10 * (worst_interpolation.rotation_deg + 0.015));
-  std::printf("pairing vs truth over %d frames: worst %.3f mm, %.4f deg; interpolation alone %.3f mm, %.4f deg; "
-              "latency forgotten %.1f mm, %.2f deg\n",
-              frames, worst.position_m * 1e3, worst.rotation_deg, worst_interpolation.position_m * 1e3,
-              worst_interpolation.rotation_deg, worst_stale.position_m * 1e3, worst_stale.rotation_deg);
+  std::printf(
+      "pairing vs truth over %d frames: worst %.3f mm, %.4f deg; interpolation alone %.3f mm, %.4f deg; "
+      "latency forgotten %.1f mm, %.2f deg\n",
+      frames, worst.position_m * 1e3, worst.rotation_deg, worst_interpolation.position_m * 1e3,
+      worst_interpolation.rotation_deg, worst_stale.position_m * 1e3, worst_stale.rotation_deg);
 }
 
 // recordings/orbit: 48 frames at 24 fps, a 60 Hz ISOTRAK II with 0.75 deg and 2.5 mm

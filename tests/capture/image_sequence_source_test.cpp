@@ -147,17 +147,27 @@ TEST(ImageSequenceSource, BadInputIsOneLineNamingTheFile) {
   using test::input_error_message;
 
   write_table(table, {"frame-1.png,0", "frame-7.png,10"});
-  EXPECT_THAT(input_error_message([&] { ImageSequenceSource({s.dir.string(), table, 0}); }),
+  EXPECT_THAT(input_error_message([&] {
+                ImageSequenceSource({s.dir.string(), table, 0});
+              }),
               HasSubstr("times.csv:3: no such image"));
   write_table(table, {"frame-1.png,100", "frame-2.png,100"});
-  EXPECT_THAT(input_error_message([&] { ImageSequenceSource({s.dir.string(), table, 0}); }),
+  EXPECT_THAT(input_error_message([&] {
+                ImageSequenceSource({s.dir.string(), table, 0});
+              }),
               HasSubstr("times.csv:3: time 100 does not increase"));
   write_table(table, {"frame-1.png,1e9"});
-  EXPECT_THAT(input_error_message([&] { ImageSequenceSource({s.dir.string(), table, 0}); }),
+  EXPECT_THAT(input_error_message([&] {
+                ImageSequenceSource({s.dir.string(), table, 0});
+              }),
               HasSubstr("times.csv:2: time_ns '1e9' is not an integer"));
-  EXPECT_THAT(input_error_message([&] { ImageSequenceSource({s.dir.string(), {}, 0}); }),
+  EXPECT_THAT(input_error_message([&] {
+                ImageSequenceSource({s.dir.string(), {}, 0});
+              }),
               HasSubstr("needs a timestamp table or a frame rate"));
-  EXPECT_THAT(input_error_message([&] { ImageSequenceSource({(s.dir / "nothing-*.png").string(), {}, 10}); }),
+  EXPECT_THAT(input_error_message([&] {
+                ImageSequenceSource({(s.dir / "nothing-*.png").string(), {}, 10});
+              }),
               HasSubstr("no image files"));
 
   // A frame of another size, and a file that is not an image, fail when read.

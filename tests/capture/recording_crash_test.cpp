@@ -113,8 +113,7 @@ TEST(RecordingCrash, KillNineLeavesAReadableRecording) {
     }
     std::error_code ec;
     ready = count_lines(dir / "frames.csv") >= 61 && has_partial_segment(dir / "video") &&
-            fs::file_size(dir / "tracker.raw", ec) > 0 && !ec &&
-            count_lines(dir / "poses.csv") >= 2;
+            fs::file_size(dir / "tracker.raw", ec) > 0 && !ec && count_lines(dir / "poses.csv") >= 2;
     if (!ready) usleep(2000);
   }
   ASSERT_TRUE(ready) << "the writer child made no progress";

@@ -134,12 +134,10 @@ TEST(TornCsv, FinalPartialLineIsIgnoredButABadRowIsAnError) {
 TEST(RecordingReaderErrors, NameTheFileThatIsWrong) {
   const fs::path root = test::scratch_dir("reader-errors");
   const test::RemoveOnSuccess cleanup{root};
-  EXPECT_THAT(test::input_error_message([&] { RecordingReader r(root / "nowhere"); }),
-              HasSubstr("nowhere"));
+  EXPECT_THAT(test::input_error_message([&] { RecordingReader r(root / "nowhere"); }), HasSubstr("nowhere"));
 
   fs::create_directories(root / "empty");
-  EXPECT_THAT(test::input_error_message([&] { RecordingReader r(root / "empty"); }),
-              HasSubstr("empty/session.json"));
+  EXPECT_THAT(test::input_error_message([&] { RecordingReader r(root / "empty"); }), HasSubstr("empty/session.json"));
 
   const fs::path dir = root / "rec";
   {
@@ -152,13 +150,11 @@ TEST(RecordingReaderErrors, NameTheFileThatIsWrong) {
   EXPECT_THAT(test::input_error_message([&] { RecordingReader r(dir); }),
               HasSubstr("rec/session.json: malformed JSON"));
   write_text(dir / "session.json", "[1, 2]");
-  EXPECT_THAT(test::input_error_message([&] { RecordingReader r(dir); }),
-              HasSubstr("rec/session.json"));
+  EXPECT_THAT(test::input_error_message([&] { RecordingReader r(dir); }), HasSubstr("rec/session.json"));
   auto session = nlohmann::json::parse(good_session);
   session["format"] = "something-else";
   write_text(dir / "session.json", session.dump());
-  EXPECT_THAT(test::input_error_message([&] { RecordingReader r(dir); }),
-              HasSubstr("rec/session.json"));
+  EXPECT_THAT(test::input_error_message([&] { RecordingReader r(dir); }), HasSubstr("rec/session.json"));
   session["format"] = "lumar-recording";
   session["version"] = 2;
   write_text(dir / "session.json", session.dump());
@@ -167,22 +163,19 @@ TEST(RecordingReaderErrors, NameTheFileThatIsWrong) {
   session["version"] = 1;
   session["video"].erase("width");
   write_text(dir / "session.json", session.dump());
-  EXPECT_THAT(test::input_error_message([&] { RecordingReader r(dir); }),
-              HasSubstr("rec/session.json"));
+  EXPECT_THAT(test::input_error_message([&] { RecordingReader r(dir); }), HasSubstr("rec/session.json"));
   write_text(dir / "session.json", good_session);
   ASSERT_NO_THROW(RecordingReader{dir});
 
   write_text(dir / "frames.csv", "1,abc,0,1\n", /*append=*/true);
-  EXPECT_THAT(test::input_error_message([&] { RecordingReader r(dir); }),
-              HasSubstr("rec/frames.csv:5"));
+  EXPECT_THAT(test::input_error_message([&] { RecordingReader r(dir); }), HasSubstr("rec/frames.csv:5"));
   write_text(dir / "frames.csv", std::string(kFramesHeader) + "\n0,0,0,0\n0,1,0,2\n");
   EXPECT_THAT(test::input_error_message([&] { RecordingReader r(dir); }),
               HasSubstr("rec/frames.csv:3"));  // skips segment frame 1
 
   fs::remove(dir / "poses.csv");
   write_text(dir / "frames.csv", std::string(kFramesHeader) + "\n");
-  EXPECT_THAT(test::input_error_message([&] { RecordingReader(dir).poses(); }),
-              HasSubstr("rec/poses.csv"));
+  EXPECT_THAT(test::input_error_message([&] { RecordingReader(dir).poses(); }), HasSubstr("rec/poses.csv"));
 }
 
 class TruncatedSegment : public testing::TestWithParam<std::string> {};
@@ -236,9 +229,10 @@ TEST(RecordingWriterErrors, RefusesAnOccupiedDirectoryAndBadFrames) {
               HasSubstr("file: exists and is not a directory"));
 
   RecordingSettings bad = small_settings("h264");
-  EXPECT_THAT(test::input_error_message([&] { RecordingWriter w(root / "codec", {}, bad); }),
-              HasSubstr("h264"));
-  EXPECT_THAT(test::input_error_message([&] { RecordingWriter w(root / "arr", {1, 2}, small_settings()); }),
+  EXPECT_THAT(test::input_error_message([&] { RecordingWriter w(root / "codec", {}, bad); }), HasSubstr("h264"));
+  EXPECT_THAT(test::input_error_message([&] {
+                RecordingWriter w(root / "arr", {1, 2}, small_settings());
+              }),
               HasSubstr("JSON object"));
 
   RecordingWriter writer(root / "rec", {}, small_settings());

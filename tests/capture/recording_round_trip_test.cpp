@@ -29,8 +29,7 @@ TEST_P(RecordingRoundTrip, ReadsBackWhatWasWritten) {
   const std::string codec = GetParam();
   const fs::path dir = test::scratch_dir("round-trip-" + codec) / "rec";
   const test::RemoveOnSuccess cleanup{dir.parent_path()};
-  const nlohmann::json caller = {{"camera", {{"fx", 512.12345678901234}, {"k1", -0.25}}},
-                                 {"tracker", "fastrak"}};
+  const nlohmann::json caller = {{"camera", {{"fx", 512.12345678901234}, {"k1", -0.25}}}, {"tracker", "fastrak"}};
   RecordingSettings settings;
   settings.codec = codec;
   settings.size = kSize;
@@ -68,8 +67,7 @@ TEST_P(RecordingRoundTrip, ReadsBackWhatWasWritten) {
   std::vector<std::string> files;
   for (const auto& e : fs::directory_iterator(dir / "video")) files.push_back(e.path().filename());
   std::sort(files.begin(), files.end());
-  EXPECT_EQ(files, (std::vector<std::string>{"segment-000000" + ext, "segment-000001" + ext,
-                                             "segment-000002" + ext}));
+  EXPECT_EQ(files, (std::vector<std::string>{"segment-000000" + ext, "segment-000001" + ext, "segment-000002" + ext}));
   EXPECT_FALSE(fs::exists(dir / "session.json.tmp"));
 
   const auto& frames = reader.frames();
@@ -221,7 +219,7 @@ TEST(RecordingWriter, MjpegQualityReachesTheEncoder) {
       error[k] = std::max(error[k], test::mean_abs_diff(frame.image, numbered_image(i, kSize)));
   }
   EXPECT_LT(bytes[0] * 10, bytes[1] * 9);  // quality 50 is smaller (measured 0.80x)...
-  EXPECT_GT(error[0], error[1]);          // ...and less accurate
+  EXPECT_GT(error[0], error[1]);           // ...and less accurate
 }
 
 }  // namespace

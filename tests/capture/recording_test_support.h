@@ -31,17 +31,14 @@ inline cv::Mat numbered_image(std::int64_t i, cv::Size size) {
   cv::Mat img(size, CV_8UC3);
   for (int y = 0; y < size.height; ++y)
     for (int x = 0; x < size.width; ++x)
-      img.at<cv::Vec3b>(y, x) = cv::Vec3b(std::uint8_t(x * 255 / size.width),
-                                          std::uint8_t(y * 255 / size.height),
+      img.at<cv::Vec3b>(y, x) = cv::Vec3b(std::uint8_t(x * 255 / size.width), std::uint8_t(y * 255 / size.height),
                                           std::uint8_t((i * 37) % 256));
   const cv::Rect block(size.width / 4, size.height / 4, size.width / 2, size.height / 2);
   cv::rectangle(img, block,
-                cv::Scalar(double((i * 53) % 256), double((i * 101 + 50) % 256),
-                           double((i * 151 + 100) % 256)),
+                cv::Scalar(double((i * 53) % 256), double((i * 101 + 50) % 256), double((i * 151 + 100) % 256)),
                 cv::FILLED);
-  cv::putText(img, std::to_string(i), {block.x + 4, block.y + block.height - 8},
-              cv::FONT_HERSHEY_SIMPLEX, size.height / 80.0, cv::Scalar(255, 255, 255),
-              std::max(1, size.height / 60));
+  cv::putText(img, std::to_string(i), {block.x + 4, block.y + block.height - 8}, cv::FONT_HERSHEY_SIMPLEX,
+              size.height / 80.0, cv::Scalar(255, 255, 255), std::max(1, size.height / 60));
   return img;
 }
 
@@ -55,7 +52,7 @@ inline constexpr Nanos kFramePeriod = 33'333'333;
 inline tracking::ByteChunk numbered_chunk(int i) {
   tracking::ByteChunk c;
   c.arrival = i == 1 ? -12'345 : Nanos(i) * 1'000'003 + 5;  // negative: before the first frame
-  const int size = (i * 37) % 61;  // chunk 0 is empty
+  const int size = (i * 37) % 61;                           // chunk 0 is empty
   for (int k = 0; k < size; ++k) c.bytes.push_back(std::uint8_t((i * 13 + k * 7) & 0xFF));
   return c;
 }
@@ -72,9 +69,7 @@ inline Pose numbered_pose(int i) {
   return p;
 }
 
-inline tracking::PoseSample numbered_sample(int i) {
-  return {Nanos(i) * 8'333'333 + 3, 1 + i % 2, numbered_pose(i)};
-}
+inline tracking::PoseSample numbered_sample(int i) { return {Nanos(i) * 8'333'333 + 3, 1 + i % 2, numbered_pose(i)}; }
 
 inline void expect_same_pose(const Pose& a, const Pose& b) {
   EXPECT_EQ(a.translation.x, b.translation.x);

@@ -17,8 +17,8 @@
 #include <string>
 #include <vector>
 
-#include "lumar/capture/v4l2_device.h"
 #include "lumar/base/time.h"
+#include "lumar/capture/v4l2_device.h"
 
 namespace lumar::test {
 
@@ -32,14 +32,14 @@ struct ScriptStep {
 
 struct ScriptedCamera {
   std::set<std::string> paths{"/dev/video0"};
-  std::set<std::string> unopenable;             // open() gives EACCES
+  std::set<std::string> unopenable;  // open() gives EACCES
   std::uint32_t device_caps = V4L2_CAP_VIDEO_CAPTURE | V4L2_CAP_STREAMING;
   std::vector<std::pair<std::string, bool>> formats{{"YUYV", false}, {"MJPG", false}};  // fourcc, emulated
-  int width = 64, height = 48;                  // the only size it has
+  int width = 64, height = 48;                                                          // the only size it has
   std::uint32_t timestamp_flags = V4L2_BUF_FLAG_TIMESTAMP_MONOTONIC | V4L2_BUF_FLAG_TSTAMP_SRC_EOF;
   std::uint32_t max_buffers = 8;
   bool has_exposure_controls = true;
-  int exposure_100us = 100;                     // 10 ms
+  int exposure_100us = 100;  // 10 ms
   std::deque<ScriptStep> steps;
 };
 
@@ -154,10 +154,14 @@ class ScriptedV4l2Device final : public capture::V4l2Device {
       case VIDIOC_QUERYCTRL: {
         auto* q = static_cast<v4l2_queryctrl*>(arg);
         if (!cam_.has_exposure_controls) return fail(EINVAL);
-        if (q->id == V4L2_CID_EXPOSURE_AUTO) q->minimum = 0, q->maximum = 3;
-        else if (q->id == V4L2_CID_EXPOSURE_ABSOLUTE) q->minimum = 1, q->maximum = 5000;
-        else if (q->id == V4L2_CID_GAIN) q->minimum = 0, q->maximum = 255;
-        else return fail(EINVAL);
+        if (q->id == V4L2_CID_EXPOSURE_AUTO)
+          q->minimum = 0, q->maximum = 3;
+        else if (q->id == V4L2_CID_EXPOSURE_ABSOLUTE)
+          q->minimum = 1, q->maximum = 5000;
+        else if (q->id == V4L2_CID_GAIN)
+          q->minimum = 0, q->maximum = 255;
+        else
+          return fail(EINVAL);
         return 0;
       }
       case VIDIOC_S_CTRL: {

@@ -100,8 +100,7 @@ TEST(VideoFileSource, MissingOrUndecodableFileIsAnInputError) {
   EXPECT_THAT(test::input_error_message([&] { VideoFileSource s(root / "absent.avi"); }),
               HasSubstr("absent.avi: no such video file"));
   std::ofstream(root / "notes.avi") << "this is not a video\n";
-  EXPECT_THAT(test::input_error_message([&] { VideoFileSource s(root / "notes.avi"); }),
-              HasSubstr("notes.avi"));
+  EXPECT_THAT(test::input_error_message([&] { VideoFileSource s(root / "notes.avi"); }), HasSubstr("notes.avi"));
 }
 
 }  // namespace

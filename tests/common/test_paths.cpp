@@ -25,8 +25,7 @@ std::vector<std::filesystem::path> checkerboard_images() {
 }
 
 std::filesystem::path scratch_dir(const std::string& name) {
-  auto dir = std::filesystem::temp_directory_path() /
-             ("lumar-test-" + std::to_string(getpid()) + "-" + name);
+  auto dir = std::filesystem::temp_directory_path() / ("lumar-test-" + std::to_string(getpid()) + "-" + name);
   std::filesystem::remove_all(dir);
   std::filesystem::create_directories(dir);
   return dir;

@@ -8,12 +8,12 @@
 #include "lumar/base/color.h"
 #include "lumar/base/error.h"
 
+#include "lumar/base/latlong.h"
 #include "lumar/envmap/envmap_quality.h"
 #include "lumar/envmap/envmap_stitcher.h"
 #include "lumar/envmap/hole_filling.h"
 #include "lumar/envmap/orientation_refinement.h"
 #include "lumar/envmap/sweep_path.h"
-#include "lumar/base/latlong.h"
 #include "lumar/lighting/sh.h"
 #include "sweep_fixture.h"
 #include "test_paths.h"
@@ -109,7 +109,8 @@ TEST(EnvmapStitcher, ShortExposuresRecoverWhatLongOnesClip) {
   };
   const EnvironmentMap bracketed = stitch({0.4, 0.4 / 64, 0.4 / 4096});
   const EnvironmentMap single = stitch({0.4});
-  const int lamp_col = int(latlong_coordinates(lamp, 256, 128).x), lamp_row = int(latlong_coordinates(lamp, 256, 128).y);
+  const int lamp_col = int(latlong_coordinates(lamp, 256, 128).x),
+            lamp_row = int(latlong_coordinates(lamp, 256, 128).y);
   EXPECT_NEAR(bracketed.texel(lamp_col, lamp_row).g, 3000.f, 3000.f * 0.05f);
   EXPECT_LT(single.texel(lamp_col, lamp_row).g, 10.f) << "one long exposure can only give a lower bound";
   // Away from the lamp both agree with the map (the dark exposures take little weight).
@@ -151,7 +152,8 @@ Quality reconstruct(const test::Sweep& sweep, const std::vector<glm::dquat>& rot
     q.worst_irradiance_direct =
         std::max(q.worst_irradiance_direct, std::abs(luminance(calib::irradiance_direct(result, n)) - want) / want);
     const double want_sh = luminance(sh9_irradiance(sh_reference, n));
-    q.worst_irradiance_sh = std::max(q.worst_irradiance_sh, std::abs(luminance(sh9_irradiance(sh_result, n)) - want_sh) / want_sh);
+    q.worst_irradiance_sh =
+        std::max(q.worst_irradiance_sh, std::abs(luminance(sh9_irradiance(sh_result, n)) - want_sh) / want_sh);
   }
   return q;
 }
@@ -176,4 +178,3 @@ INSTANTIATE_TEST_SUITE_P(Maps, SharedMapSweep, ::testing::Values("studio"));
 
 }  // namespace
 }  // namespace lumar
-

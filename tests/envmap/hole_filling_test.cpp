@@ -5,8 +5,8 @@
 
 #include "lumar/base/error.h"
 
-#include "lumar/envmap/hole_filling.h"
 #include "lumar/base/latlong.h"
+#include "lumar/envmap/hole_filling.h"
 
 namespace lumar {
 namespace {

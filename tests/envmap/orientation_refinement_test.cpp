@@ -19,10 +19,11 @@ TEST(OrientationRefinement, BringsTrackerNoiseFrom075DegreesToAtMost015) {
   const double after = test::rms_angle_deg(result.rotations, sweep.truth);
   double mean_correction = 0;
   for (double c : result.correction_deg) mean_correction += c / result.correction_deg.size();
-  std::printf("tracker %.3f deg RMS -> refined %.3f deg RMS; %d pairs, %d matches, %d unmatched frames; "
-              "match residual %.3f -> %.3f deg; mean correction %.3f deg\n",
-              before, after, result.pairs, result.matches, result.unmatched_frames, result.residual_before_deg,
-              result.residual_after_deg, mean_correction);
+  std::printf(
+      "tracker %.3f deg RMS -> refined %.3f deg RMS; %d pairs, %d matches, %d unmatched frames; "
+      "match residual %.3f -> %.3f deg; mean correction %.3f deg\n",
+      before, after, result.pairs, result.matches, result.unmatched_frames, result.residual_before_deg,
+      result.residual_after_deg, mean_correction);
   EXPECT_NEAR(before, 0.75, 0.2) << "the fixture's tracker noise";
   EXPECT_LE(after, 0.15);
   EXPECT_EQ(result.unmatched_frames, 0);

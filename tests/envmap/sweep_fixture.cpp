@@ -26,8 +26,8 @@ double rms_angle_deg(const std::vector<glm::dquat>& a, const std::vector<glm::dq
 
 namespace {
 std::string key_of(const SweepSpec& spec) {
-  std::string key = spec.map + "/" + std::to_string(spec.frames) + "/" + std::to_string(spec.tracker_noise_deg) +
-                    "/" + std::to_string(spec.seed);
+  std::string key = spec.map + "/" + std::to_string(spec.frames) + "/" + std::to_string(spec.tracker_noise_deg) + "/" +
+                    std::to_string(spec.seed);
   for (double s : spec.exposure_stops) key += "/" + std::to_string(s);
   return key;
 }
@@ -70,7 +70,8 @@ const Sweep& synthetic_sweep(const SweepSpec& spec) {
     sweep.truth.push_back(truth);
     sweep.tracker.push_back(glm::normalize(rotation_exp(noise) * truth));
     sweep.exposures.push_back(exposure);
-    sweep.frames.push_back(calib::expose_8bit(view.render(sweep.source, truth), sweep.camera, sweep.sensor, exposure, rng));
+    sweep.frames.push_back(
+        calib::expose_8bit(view.render(sweep.source, truth), sweep.camera, sweep.sensor, exposure, rng));
   }
   return cache.emplace(key, std::move(sweep)).first->second;
 }

@@ -8,16 +8,16 @@
 #include <string>
 #include <vector>
 
-#include "lumar/sim/envmap_view.h"
-#include "lumar/envmap/orientation_refinement.h"
 #include "lumar/base/camera.h"
+#include "lumar/envmap/orientation_refinement.h"
 #include "lumar/scene/envmap.h"
+#include "lumar/sim/envmap_view.h"
 
 namespace lumar::test {
 
 struct SweepSpec {
-  std::string map = "studio";                 // a map in shared/data/envmaps
-  int frames = 180;  // 60 stations of 3
+  std::string map = "studio";  // a map in shared/data/envmaps
+  int frames = 180;            // 60 stations of 3
   // Relative to 18 % grey; bracketed: the camera stands still for each bracket.
   std::vector<double> exposure_stops = {4.0, -1.0, -6.0};
   double tracker_noise_deg = 0.75;
@@ -28,11 +28,11 @@ struct Sweep {
   EnvironmentMap source;
   CameraIntrinsics camera;
   calib::SensorModel sensor;
-  std::vector<cv::Mat> frames;         // CV_8UC3 BGR
-  std::vector<double> exposures;       // video linear value per unit radiance
-  std::vector<glm::dquat> truth;       // R_world_camera
-  std::vector<glm::dquat> tracker;     // truth with tracker noise
-  std::vector<int> groups;             // the bracket (station) of each frame
+  std::vector<cv::Mat> frames;      // CV_8UC3 BGR
+  std::vector<double> exposures;    // video linear value per unit radiance
+  std::vector<glm::dquat> truth;    // R_world_camera
+  std::vector<glm::dquat> tracker;  // truth with tracker noise
+  std::vector<int> groups;          // the bracket (station) of each frame
 };
 
 // Built once per spec and kept for the rest of the test run.

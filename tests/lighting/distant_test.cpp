@@ -6,9 +6,9 @@
 
 #include "../common/test_paths.h"
 #include "irradiance_test_util.h"
+#include "lumar/base/latlong.h"
 #include "lumar/lighting/irradiance_reference.h"
 #include "lumar/lighting/irradiance_volume.h"
-#include "lumar/base/latlong.h"
 #include "lumar/lighting/sh.h"
 
 namespace lumar::test {
@@ -70,10 +70,11 @@ TEST(IrradianceDistant, DefaultMeetsAccuracyOnTheSharedMapsAndSH9DoesNot) {
       sh.push_back(glm::max(sh9_irradiance(coefficients, n), glm::dvec3(0.0)));
     }
     const ErrorStats e = luminance_errors(ours, reference), e_sh = luminance_errors(sh, reference);
-    std::printf("%-10s default (%s): mean %.3f %%, p99 %.3f %%, max %.2f %% | SH9: mean %.2f %%, p99 %.2f %%, max %.1f %% "
-                "(%zu bright texels, %zu lights)\n",
-                name, s.describe().c_str(), 100 * e.mean, 100 * e.p99, 100 * e.max, 100 * e_sh.mean, 100 * e_sh.p99,
-                100 * e_sh.max, radiance.bright_texels().size(), radiance.lights().size());
+    std::printf(
+        "%-10s default (%s): mean %.3f %%, p99 %.3f %%, max %.2f %% | SH9: mean %.2f %%, p99 %.2f %%, max %.1f %% "
+        "(%zu bright texels, %zu lights)\n",
+        name, s.describe().c_str(), 100 * e.mean, 100 * e.p99, 100 * e.max, 100 * e_sh.mean, 100 * e_sh.p99,
+        100 * e_sh.max, radiance.bright_texels().size(), radiance.lights().size());
     EXPECT_LE(e.mean, 0.01) << name;
     EXPECT_LE(e.p99, 0.05) << name;
     EXPECT_GT(e_sh.max, 0.2) << name;  // the reason for all this
@@ -82,4 +83,3 @@ TEST(IrradianceDistant, DefaultMeetsAccuracyOnTheSharedMapsAndSH9DoesNot) {
 
 }  // namespace
 }  // namespace lumar::test
-

@@ -11,10 +11,10 @@
 
 #include "../common/test_paths.h"
 #include "irradiance_test_util.h"
+#include "lumar/lighting/irradiance_volume.h"
 #include "lumar/render/compositor.h"
 #include "lumar/render/platform/context.h"
 #include "lumar/render/renderer.h"
-#include "lumar/lighting/irradiance_volume.h"
 #include "lumar/scene/scene.h"
 
 namespace lumar::test {

@@ -67,11 +67,16 @@ DividedRoom make_divided_room() {
       glm::vec3 L(0.05f, 0.05f, 0.05f);
       if (const auto hit = rays.intersect(ray)) {
         const glm::dvec3 x = map.capture_position + d * double(hit->t);
-        if (x.x < -2.999 && x.y > 1.2 && x.y < 2.0 && x.z > -0.9 && x.z < -0.3) L = {28.0f, 30.0f, 34.0f};
-        else if (x.y > 2.999 && glm::length(glm::dvec2(x.x + 1.0, x.z + 0.2)) < 0.06) L = {2200.0f, 2000.0f, 1700.0f};
-        else if (x.y < 0.001) L = {0.04f, 0.03f, 0.02f};
-        else if (x.y > 2.999) L = {0.08f, 0.08f, 0.08f};
-        else L = {0.05f + 0.02f * float(x.z > 0), 0.05f, 0.045f};
+        if (x.x < -2.999 && x.y > 1.2 && x.y < 2.0 && x.z > -0.9 && x.z < -0.3)
+          L = {28.0f, 30.0f, 34.0f};
+        else if (x.y > 2.999 && glm::length(glm::dvec2(x.x + 1.0, x.z + 0.2)) < 0.06)
+          L = {2200.0f, 2000.0f, 1700.0f};
+        else if (x.y < 0.001)
+          L = {0.04f, 0.03f, 0.02f};
+        else if (x.y > 2.999)
+          L = {0.08f, 0.08f, 0.08f};
+        else
+          L = {0.05f + 0.02f * float(x.z > 0), 0.05f, 0.045f};
       }
       float* p = &map.rgb[(std::size_t(r) * map.width + c) * 3];
       p[0] = L.r, p[1] = L.g, p[2] = L.b;

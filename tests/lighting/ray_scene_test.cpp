@@ -32,17 +32,15 @@ std::optional<float> brute_force_hit(const Mesh& m, const glm::dmat4& T, const R
   return best;
 }
 
-Mesh figurine() {
-  return load_mesh(test::shared_dir() / "data/models/parasaurolophus_6700.ply");
-}
+Mesh figurine() { return load_mesh(test::shared_dir() / "data/models/parasaurolophus_6700.ply"); }
 
 TEST(RayScene, NearestHitsMatchBruteForceOnInstancedFigurine) {
   const Mesh mesh = figurine();
   const auto [lo, hi] = mesh.bounds();
   const glm::dvec3 centre = (glm::dvec3(lo) + glm::dvec3(hi)) * 0.5;
   glm::dmat4 T = glm::translate(glm::dmat4(1.0), glm::dvec3(0.3, 0.2, -0.1)) *
-                 glm::rotate(glm::dmat4(1.0), 0.7, glm::dvec3(0, 1, 0)) * glm::scale(glm::dmat4(1.0), glm::dvec3(0.002)) *
-                 glm::translate(glm::dmat4(1.0), -centre);
+                 glm::rotate(glm::dmat4(1.0), 0.7, glm::dvec3(0, 1, 0)) *
+                 glm::scale(glm::dmat4(1.0), glm::dvec3(0.002)) * glm::translate(glm::dmat4(1.0), -centre);
   RayScene scene;
   const int id = scene.add_instance(mesh, glm::dmat4(1.0));
   scene.set_instance_transform(id, T);  // moved after creation: must take effect

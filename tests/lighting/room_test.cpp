@@ -7,10 +7,10 @@
 
 #include "../common/test_paths.h"
 #include "irradiance_test_util.h"
-#include "lumar/lighting/irradiance_reference.h"
-#include "lumar/lighting/irradiance_volume.h"
 #include "lumar/base/error.h"
 #include "lumar/base/latlong.h"
+#include "lumar/lighting/irradiance_reference.h"
+#include "lumar/lighting/irradiance_volume.h"
 
 namespace lumar::test {
 namespace {
@@ -81,8 +81,8 @@ TEST(IrradianceRoom, VolumeMatchesTheReferenceAcrossTheMovementBox) {
   const Fixture& f = fixture();
   const auto& st = f.volume.stats();
   std::printf("volume: %d probes (%d moved, %d disabled), %d cells (%d refined), %.0f ms, %llu rays, %llu fallback\n",
-              st.probes, st.moved, st.disabled, st.cells, st.refined_cells, st.build_ms,
-              (unsigned long long)st.rays, (unsigned long long)st.fallback_rays);
+              st.probes, st.moved, st.disabled, st.cells, st.refined_cells, st.build_ms, (unsigned long long)st.rays,
+              (unsigned long long)st.fallback_rays);
   EXPECT_GT(st.refined_cells, 0);
   EXPECT_LT(st.refined_cells, st.cells);
   EXPECT_GT(st.moved + st.disabled, 0);  // probes in the wall and the table
@@ -106,8 +106,8 @@ TEST(IrradianceRoom, VolumeMatchesTheReferenceAcrossTheMovementBox) {
       std::printf("  point (%.2f %.2f %.2f) n (%.2f %.2f %.2f): volume %.4f reference %.4f\n", points[i].x, points[i].y,
                   points[i].z, normals[i].x, normals[i].y, normals[i].z, luminance(ours[i]), luminance(reference[i]));
   }
-  std::printf("volume vs reference at %zu points: mean %.2f %%, p99 %.1f %%, max %.1f %%\n", points.size(), 100 * e.mean,
-              100 * e.p99, 100 * e.max);
+  std::printf("volume vs reference at %zu points: mean %.2f %%, p99 %.1f %%, max %.1f %%\n", points.size(),
+              100 * e.mean, 100 * e.p99, 100 * e.max);
   EXPECT_LE(e.mean, 0.03);  // issue 7
 }
 
@@ -146,11 +146,11 @@ TEST(IrradianceRoom, LightShadowMapsAgreeWithRays) {
   EXPECT_LE(wrong, tested / 50);
 }
 
-
 TEST(IrradianceRoom, NoLightLeaksThroughTheDividingWall) {
   const Fixture& f = fixture();
   std::mt19937 rng(3);
-  const auto pick = [&](double x0, double x1, double z0, double z1, std::vector<glm::dvec3>& p, std::vector<glm::dvec3>& n) {
+  const auto pick = [&](double x0, double x1, double z0, double z1, std::vector<glm::dvec3>& p,
+                        std::vector<glm::dvec3>& n) {
     while (p.size() < 20) {
       const glm::dvec3 q(std::uniform_real_distribution<double>(x0, x1)(rng),
                          std::uniform_real_distribution<double>(0.2, 1.5)(rng),

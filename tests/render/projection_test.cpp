@@ -57,14 +57,12 @@ TEST(RenderProjection, CoveredPixelsReprojectOntoThemselves) {
   };
   const glm::dmat4 far_away = glm::translate(glm::dmat4(1.0), {0, -100, 0});
   const std::vector<Case> cases = {
-      {"centred", look_at({0, 1.4, 1.6}, {0, 1.0, 0}),
-       glm::translate(glm::dmat4(1.0), {0.1, 1.0, 0}), far_away},
+      {"centred", look_at({0, 1.4, 1.6}, {0, 1.0, 0}), glm::translate(glm::dmat4(1.0), {0.1, 1.0, 0}), far_away},
       {"off-centre, rolled camera", look_at({1.2, 1.7, 1.4}, {0.1, 0.9, -0.3}, 23.0),
        glm::translate(glm::dmat4(1.0), {0.8, 1.3, -0.2}),
        glm::rotate(glm::translate(glm::dmat4(1.0), {-0.3, 0.7, 0.1}), glm::radians(37.0),
                    glm::normalize(glm::dvec3(1, 2, -1)))},
-      {"scaled, rotated box near the corner", look_at({-0.8, 0.4, 2.0}, {0.5, 1.2, -0.5}, -70.0),
-       far_away,
+      {"scaled, rotated box near the corner", look_at({-0.8, 0.4, 2.0}, {0.5, 1.2, -0.5}, -70.0), far_away,
        glm::scale(glm::rotate(glm::translate(glm::dmat4(1.0), {0.0, 0.7, 0.3}), glm::radians(-121.0),
                               glm::normalize(glm::dvec3(0.3, -1, 0.4))),
                   {1.5, 0.7, 1.2})},
@@ -76,8 +74,7 @@ TEST(RenderProjection, CoveredPixelsReprojectOntoThemselves) {
     ASSERT_EQ(world.type(), CV_32FC4);
     ASSERT_EQ(world.size(), cv::Size(640, 480));
     const ProjectionError e = reprojection_error(world, camera, c.camera);
-    std::printf("%-40s covered %6d px, reprojection mean %.5f px, max %.5f px\n", c.name, e.covered, e.mean,
-                e.max);
+    std::printf("%-40s covered %6d px, reprojection mean %.5f px, max %.5f px\n", c.name, e.covered, e.mean, e.max);
     EXPECT_GT(e.covered, 1000) << c.name;
     EXPECT_LE(e.mean, 0.05) << c.name;
     EXPECT_LE(e.max, 0.5) << c.name;

@@ -40,9 +40,15 @@ void rvec_tvec(const Pose& T_world_camera, cv::Mat& rvec, cv::Mat& tvec) {
 
 std::array<double, 9> sh_basis(const glm::dvec3& d) {
   const double x = d.x, y = d.y, z = d.z;
-  return {0.282095,           0.488603 * y,     0.488603 * z,
-          0.488603 * x,       1.092548 * x * y, 1.092548 * y * z,
-          0.315392 * (3 * z * z - 1), 1.092548 * x * z, 0.546274 * (x * x - y * y)};
+  return {0.282095,
+          0.488603 * y,
+          0.488603 * z,
+          0.488603 * x,
+          1.092548 * x * y,
+          1.092548 * y * z,
+          0.315392 * (3 * z * z - 1),
+          1.092548 * x * z,
+          0.546274 * (x * x - y * y)};
 }
 
 glm::dvec3 sh_irradiance_reference(const SH9& sh, const glm::dvec3& n) {

@@ -4,10 +4,10 @@
 #include <opencv2/core.hpp>
 
 #include "lumar/base/camera.h"
-#include "lumar/render/platform/context.h"
-#include "lumar/scene/mesh.h"
 #include "lumar/base/pose.h"
 #include "lumar/lighting/sh.h"
+#include "lumar/render/platform/context.h"
+#include "lumar/scene/mesh.h"
 #include "test_geometry.h"
 
 namespace lumar::test {

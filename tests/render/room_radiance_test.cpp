@@ -6,8 +6,8 @@
 #include <numbers>
 
 #include "lumar/base/error.h"
-#include "lumar/render/renderer.h"
 #include "lumar/base/latlong.h"
+#include "lumar/render/renderer.h"
 #include "render_test_util.h"
 
 namespace lumar::test {
@@ -68,8 +68,8 @@ class RenderRoomRadiance : public testing::Test {
 };
 
 TEST_F(RenderRoomRadiance, UniformMapGivesItsColourEverywhere) {
-  renderer->set_environment(make_map(64, 32, {0.3, 1.2, -0.4}, 35.0,
-                                     [](double, double) { return glm::vec3(0.2f, 0.4f, 0.6f); }));
+  renderer->set_environment(
+      make_map(64, 32, {0.3, 1.2, -0.4}, 35.0, [](double, double) { return glm::vec3(0.2f, 0.4f, 0.6f); }));
   const cv::Mat out = renderer->render_room_radiance(camera, pose);
   ASSERT_EQ(out.type(), CV_32FC3);
   ASSERT_EQ(out.size(), cv::Size(200, 150));

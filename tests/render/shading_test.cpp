@@ -6,8 +6,8 @@
 #include <numbers>
 
 #include "lumar/base/color.h"
-#include "lumar/render/renderer.h"
 #include "lumar/base/latlong.h"
+#include "lumar/render/renderer.h"
 #include "render_test_util.h"
 
 namespace lumar::test {
@@ -91,8 +91,8 @@ TEST(RenderShading, UniformLightGivesAlbedoTimesExposure) {
         else
           background_worst = std::max(background_worst, v);
       }
-  std::printf("uniform light: expected BGR (%d, %d, %d), max |diff| %d levels over %d object pixels\n",
-              expected[0], expected[1], expected[2], worst, cv::countNonZero(mask));
+  std::printf("uniform light: expected BGR (%d, %d, %d), max |diff| %d levels over %d object pixels\n", expected[0],
+              expected[1], expected[2], worst, cv::countNonZero(mask));
   EXPECT_LE(worst, 1);
   EXPECT_EQ(background_worst, 0);
 }
@@ -101,8 +101,8 @@ TEST(RenderShading, DirectionalIrradianceMatchesCpuFormula) {
   headless_context();
   // Upper hemisphere only, the reference case: E(up) = pi, E(down) = 0, E(sideways) = pi / 2,
   // and order-2 SH is exact at these three normals.
-  const SH9 hemisphere = integrate_sh(
-      [](const glm::dvec3& d) { return d.y > 0 ? glm::dvec3(1.0) : glm::dvec3(0.0); }, 512, 256);
+  const SH9 hemisphere =
+      integrate_sh([](const glm::dvec3& d) { return d.y > 0 ? glm::dvec3(1.0) : glm::dvec3(0.0); }, 512, 256);
   EXPECT_NEAR(sh_irradiance_reference(hemisphere, {0, 1, 0}).x, kPi, 0.01 * kPi);
   EXPECT_NEAR(sh_irradiance_reference(hemisphere, {0, -1, 0}).x, 0.0, 0.01 * kPi);
   EXPECT_NEAR(sh_irradiance_reference(hemisphere, {1, 0, 0}).x, kPi / 2, 0.01 * kPi);
@@ -117,9 +117,9 @@ TEST(RenderShading, DirectionalIrradianceMatchesCpuFormula) {
       },
       256, 128);
 
-  const std::vector<glm::dvec3> normals = {
-      {0, 1, 0},  {0, -1, 0}, {1, 0, 0},   {-1, 0, 0},   {0, 0, 1},    {0, 0, -1},
-      {1, 1, 0},  {0.3, -0.5, 0.81}, {-0.6, 0.2, -0.77}, {0.5, 0.7, 0.5}, {-0.2, 0.9, 0.4}, {0.7, -0.1, -0.7}};
+  const std::vector<glm::dvec3> normals = {{0, 1, 0},          {0, -1, 0},      {1, 0, 0},        {-1, 0, 0},
+                                           {0, 0, 1},          {0, 0, -1},      {1, 1, 0},        {0.3, -0.5, 0.81},
+                                           {-0.6, 0.2, -0.77}, {0.5, 0.7, 0.5}, {-0.2, 0.9, 0.4}, {0.7, -0.1, -0.7}};
   const std::vector<std::pair<const char*, SH9>> lights = {{"hemisphere", hemisphere}, {"sky", sky}};
   QuadGrid grid(normals);
   const glm::vec3 albedo(0.9f, 0.7f, 0.8f);
@@ -169,7 +169,7 @@ TEST(RenderShading, AgreesWithCoreShProjectionAndIrradiance) {
                                      float(0.25 + (window ? 1.5 : 0.0) + 0.1 * d.z)});
     }
   const SH9 sh = project_radiance_sh9(map);
-  const std::vector<glm::dvec3> normals = {{1, 0.3, 0}, {0, 1, 0}, {-1, 0, 0}, {0, 0, 1},
+  const std::vector<glm::dvec3> normals = {{1, 0.3, 0}, {0, 1, 0},        {-1, 0, 0},      {0, 0, 1},
                                            {0, 0, -1},  {0.6, 0.6, -0.5}, {0.6, 0.6, 0.5}, {0, -1, 0}};
   QuadGrid grid(normals);
   const glm::vec3 albedo(0.6f, 0.8f, 0.7f);

@@ -63,8 +63,8 @@ TEST(RenderUndistortion, MatchesCvRemap) {
       ++count;
     }
   const double mean = sum / (3.0 * count);
-  std::printf("undistortion vs cv::remap: %d interior pixels, mean |diff| %.4f levels, max %d levels\n", count,
-              mean, worst);
+  std::printf("undistortion vs cv::remap: %d interior pixels, mean |diff| %.4f levels, max %d levels\n", count, mean,
+              worst);
   EXPECT_GT(count, size.area() / 2);
   EXPECT_LE(mean, 1.0);
   // The distortion is strong at the corners: the warp must really be applied.
@@ -87,8 +87,8 @@ TEST(RenderUndistortion, WithoutMapTheVideoRoundTripsExactly) {
   const cv::Mat out = renderer.render_overlay(frame, Pose{}, 1.0, &timings);
   // Filled in when asked for (no claim about how fast: that is the benchmark's job).
   EXPECT_GE(timings.upload_ms, 0.0);
-  EXPECT_GT(timings.upload_ms + timings.background_ms + timings.depth_ms + timings.objects_ms +
-                timings.readback_ms, 0.0);
+  EXPECT_GT(timings.upload_ms + timings.background_ms + timings.depth_ms + timings.objects_ms + timings.readback_ms,
+            0.0);
   cv::Mat diff;
   cv::absdiff(out, frame, diff);
   double worst = 0;

@@ -49,8 +49,8 @@ TEST(VideoRadiometry, RenderedPixelsGetTheResponseAndTheVignetting) {
   sh.coefficients[0] = glm::dvec3(0.282095 * 4.0 * 3.14159265358979);
   renderer.set_object_material(id, albedo, sh);
   const double exposure = 0.9;
-  const cv::Mat out = renderer.render_overlay(cv::Mat(120, 160, CV_8UC3, cv::Scalar::all(0)),
-                                              look_at({0, 0, 0}, {0, 0, -1}), exposure);
+  const cv::Mat out =
+      renderer.render_overlay(cv::Mat(120, 160, CV_8UC3, cv::Scalar::all(0)), look_at({0, 0, 0}, {0, 0, -1}), exposure);
   const float gains[3] = {0.8f, 1.0f, 1.3f};
   const double linear_bgr[3] = {albedo.b * exposure, albedo.g * exposure, albedo.r * exposure};
   const double half_diagonal = 0.5 * std::hypot(160.0, 120.0);

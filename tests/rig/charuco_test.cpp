@@ -7,14 +7,14 @@
 #include <cstdlib>
 #include <fstream>
 #include <nlohmann/json.hpp>
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/calib3d.hpp>
+#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "lumar/base/error.h"
 #include "lumar/calib/camera_file.h"
 #include "lumar/calib/charuco_calibration.h"
 #include "lumar/calib/robust_calibration.h"
-#include "lumar/base/error.h"
 #include "test_paths.h"
 
 namespace lumar {
@@ -38,7 +38,8 @@ cv::Mat view_of(const cv::Mat& texture, double metres_per_pixel, const CameraInt
         double t = b.z / a.z;  // the flat board; a few fixed-point steps onto the curl
         for (int i = 0; i < 8 && k != 0.0; ++i) t = (b.z + k * std::pow(t * a.x - b.x - half_width, 2)) / a.z;
         // Texture pixel centres sit at integer coordinates: board point X is pixel X / m - 0.5.
-        if (t > 0) x = float((t * a.x - b.x) / metres_per_pixel - 0.5), y = float((t * a.y - b.y) / metres_per_pixel - 0.5);
+        if (t > 0)
+          x = float((t * a.x - b.x) / metres_per_pixel - 0.5), y = float((t * a.y - b.y) / metres_per_pixel - 0.5);
       }
       map_x.at<float>(v, u) = x;
       map_y.at<float>(v, u) = y;
@@ -49,8 +50,8 @@ cv::Mat view_of(const cv::Mat& texture, double metres_per_pixel, const CameraInt
 }
 
 struct CharucoViews {
-  CameraIntrinsics camera;            // the webcam's calibration: the truth
-  calib::CharucoBoardSpec spec;       // 7x5 squares of 40 mm, 30 mm DICT_5X5_100 markers
+  CameraIntrinsics camera;       // the webcam's calibration: the truth
+  calib::CharucoBoardSpec spec;  // 7x5 squares of 40 mm, 30 mm DICT_5X5_100 markers
   std::vector<calib::NamedImage> images;
 };
 
@@ -68,12 +69,14 @@ const CharucoViews& charuco_views(bool odd_view) {
   std::vector<cv::Point2d> pixels, rays;
   for (int y = 0; y < v.camera.height; ++y)
     for (int x = 0; x < v.camera.width; ++x) pixels.emplace_back(x, y);
-  cv::undistortPoints(pixels, rays, cv::Mat(v.camera.camera_matrix()), v.camera.distortion_coefficients(), cv::noArray(),
-                      cv::noArray(), cv::TermCriteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, 100, 1e-12));
+  cv::undistortPoints(pixels, rays, cv::Mat(v.camera.camera_matrix()), v.camera.distortion_coefficients(),
+                      cv::noArray(), cv::noArray(),
+                      cv::TermCriteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, 100, 1e-12));
   const glm::dvec3 centre(0.14, 0.10, 0.0);
   auto pose = [&](int k) {
     const double tilt_x = 30.0 * std::sin(0.9 * k), tilt_y = 30.0 * std::cos(1.3 * k), spin = 10.0 * std::sin(2.1 * k);
-    const glm::dquat R = axis_angle_deg({1, 0, 0}, tilt_x) * axis_angle_deg({0, 1, 0}, tilt_y) * axis_angle_deg({0, 0, 1}, spin);
+    const glm::dquat R =
+        axis_angle_deg({1, 0, 0}, tilt_x) * axis_angle_deg({0, 1, 0}, tilt_y) * axis_angle_deg({0, 0, 1}, spin);
     // Board centre on the optical axis, off-centre by a few centimetres, 0.45 to 0.6 m away.
     const glm::dvec3 at(0.05 * std::sin(1.7 * k), 0.04 * std::cos(2.3 * k), 0.45 + 0.15 * (k % 4) / 3.0);
     return Pose{R, at - R * centre};
@@ -91,10 +94,11 @@ TEST(Charuco, RecoversKnownIntrinsicsFromSyntheticViews) {
   const auto result = calib::calibrate_robust(views);
   const CameraIntrinsics& camera = v.camera;
   const auto& c = result.camera.intrinsics;
-  std::printf("ChArUco: %zu views, RMS %.3f px; fx %.2f (true %.2f) fy %.2f (%.2f) cx %.2f (%.2f) cy %.2f (%.2f) "
-              "k1 %.4f (%.4f) k2 %.4f (%.4f)\n",
-              result.used_views.size(), result.camera.avg_reprojection_error, c.fx, camera.fx, c.fy, camera.fy, c.cx,
-              camera.cx, c.cy, camera.cy, c.distortion[0], camera.distortion[0], c.distortion[1], camera.distortion[1]);
+  std::printf(
+      "ChArUco: %zu views, RMS %.3f px; fx %.2f (true %.2f) fy %.2f (%.2f) cx %.2f (%.2f) cy %.2f (%.2f) "
+      "k1 %.4f (%.4f) k2 %.4f (%.4f)\n",
+      result.used_views.size(), result.camera.avg_reprojection_error, c.fx, camera.fx, c.fy, camera.fy, c.cx, camera.cx,
+      c.cy, camera.cy, c.distortion[0], camera.distortion[0], c.distortion[1], camera.distortion[1]);
   EXPECT_EQ(result.used_views.size(), v.images.size());
   EXPECT_TRUE(result.rejected.empty());
   EXPECT_LT(result.camera.avg_reprojection_error, 0.3);
@@ -121,7 +125,8 @@ TEST(Charuco, CurledBoardViewIsRejected) {
   const auto result = calib::calibrate_robust(calib::detect_charuco_views(v.images, v.spec));
   std::printf("ChArUco with a curled board: RMS all views %.3f px, kept %.3f px;", result.initial_rms,
               result.camera.avg_reprojection_error);
-  for (const auto& r : result.rejected) std::printf(" rejected %s (%.3f px > %.3f px)", r.name.c_str(), r.rms_px, r.threshold_px);
+  for (const auto& r : result.rejected)
+    std::printf(" rejected %s (%.3f px > %.3f px)", r.name.c_str(), r.rms_px, r.threshold_px);
   for (std::size_t i = 0; i < result.used_views.size(); ++i)
     if (result.used_views[i] == "curled") std::printf(" curled view kept at %.3f px", result.per_view_rms[i]);
   for (const auto& name : result.views_without_board) std::printf(" no board in %s", name.c_str());

@@ -7,10 +7,10 @@
 #include <random>
 
 #include "board_recordings.h"
+#include "lumar/base/error.h"
 #include "lumar/calib/hand_eye_calibration.h"
 #include "lumar/calib/latency_estimation.h"
 #include "lumar/capture/recording_reader.h"
-#include "lumar/base/error.h"
 
 namespace lumar {
 namespace {
@@ -64,8 +64,8 @@ TEST(TimeOffset, FindsAKnownShiftBetweenTwoSpeedSignals) {
   const Nanos shift = 37'300'000;
   auto angle = [](double t) {  // integral of the speed, degrees
     const double pi = 3.14159265358979323846;
-    return 50 * t - 25 / (2 * pi * 0.3) * std::cos(2 * pi * 0.3 * t) - 10 / (2 * pi * 0.77) * std::cos(2 * pi * 0.77 * t) -
-           15 / (2 * pi * 1.1) * std::cos(2 * pi * 1.1 * t);
+    return 50 * t - 25 / (2 * pi * 0.3) * std::cos(2 * pi * 0.3 * t) -
+           10 / (2 * pi * 0.77) * std::cos(2 * pi * 0.77 * t) - 15 / (2 * pi * 1.1) * std::cos(2 * pi * 1.1 * t);
   };
   const glm::dvec3 axis = glm::normalize(glm::dvec3(0.3, 1, -0.2));
   std::vector<Nanos> vt, tt;
@@ -79,7 +79,8 @@ TEST(TimeOffset, FindsAKnownShiftBetweenTwoSpeedSignals) {
   for (int k = 0; k < 660; ++k) {
     const Nanos t = Nanos(k) * 16'666'667;
     const glm::dvec3 e(noise(rng), noise(rng), noise(rng));
-    const glm::dquat n = glm::length(e) > 0 ? axis_angle_deg(glm::normalize(e), glm::length(e)) : glm::dquat(1, 0, 0, 0);
+    const glm::dquat n =
+        glm::length(e) > 0 ? axis_angle_deg(glm::normalize(e), glm::length(e)) : glm::dquat(1, 0, 0, 0);
     tt.push_back(t + shift), tr.push_back(n * axis_angle_deg(axis, angle(nanos_to_seconds(t))));
   }
   const calib::TimeOffsetOptions options;

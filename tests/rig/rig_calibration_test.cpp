@@ -7,8 +7,8 @@
 #include <cstdio>
 
 #include "board_recordings.h"
-#include "lumar/calib/rig_calibration.h"
 #include "lumar/base/error.h"
+#include "lumar/calib/rig_calibration.h"
 
 namespace lumar {
 namespace {
@@ -20,13 +20,14 @@ const std::string kNoisy = "--seconds 12";
 const std::string kClean = "--seconds 12 --tracker-noise-deg 0 --position-noise-m 0 --latency-ms 35";
 
 void print(const char* what, const test::RigErrors& e, const calib::RigCalibrationResult& r) {
-  std::printf("%s: offset %.3f mm %.4f deg, world %.3f mm %.4f deg, latency %+.3f ms "
-              "(cross-correlation alone %+.3f ms); sigma %.3f mm %.4f deg %.3f ms; residual %.3f deg %.2f mm\n",
-              what, e.offset_mm, e.offset_deg, e.world_mm, e.world_deg, e.latency_ms,
-              nanos_to_seconds(r.assumed_latency + r.correlation_offset) * 1e3 -
-                  (nanos_to_seconds(r.rig.latency) * 1e3 - e.latency_ms),
-              r.sigma_translation_m * 1e3, r.sigma_rotation_deg, r.sigma_time_offset_s * 1e3, r.rotation_rms_deg,
-              r.translation_rms_m * 1e3);
+  std::printf(
+      "%s: offset %.3f mm %.4f deg, world %.3f mm %.4f deg, latency %+.3f ms "
+      "(cross-correlation alone %+.3f ms); sigma %.3f mm %.4f deg %.3f ms; residual %.3f deg %.2f mm\n",
+      what, e.offset_mm, e.offset_deg, e.world_mm, e.world_deg, e.latency_ms,
+      nanos_to_seconds(r.assumed_latency + r.correlation_offset) * 1e3 -
+          (nanos_to_seconds(r.rig.latency) * 1e3 - e.latency_ms),
+      r.sigma_translation_m * 1e3, r.sigma_rotation_deg, r.sigma_time_offset_s * 1e3, r.rotation_rms_deg,
+      r.translation_rms_m * 1e3);
 }
 
 TEST(RigCalibration, MeetsAcceptanceWithIsotrakNoise) {

@@ -42,8 +42,7 @@ EnvironmentMap gradient_map(int width, int height) {
   map.rgb.resize(std::size_t(width) * height * 3);
   for (int r = 0; r < height; ++r)
     for (int c = 0; c < width; ++c)
-      for (int k = 0; k < 3; ++k)
-        map.rgb[(std::size_t(r) * width + c) * 3 + k] = float(1 + c + 1000 * r + 0.25 * k);
+      for (int k = 0; k < 3; ++k) map.rgb[(std::size_t(r) * width + c) * 3 + k] = float(1 + c + 1000 * r + 0.25 * k);
   return map;
 }
 
@@ -143,7 +142,8 @@ TEST(EnvironmentMap, RadianceAtTexelCentresIsTheTexel) {
       ASSERT_EQ(map.radiance(world), map.texel(c, r)) << c << "," << r;
       ++checked;
     }
-  for (const auto& [c, r] : {std::pair{0, 0}, {map.width - 1, 0}, {0, map.height - 1}, {map.width - 1, map.height - 1}}) {
+  for (const auto& [c, r] :
+       {std::pair{0, 0}, {map.width - 1, 0}, {0, map.height - 1}, {map.width - 1, map.height - 1}}) {
     const glm::dvec3 world = map.world_direction(latlong_pixel_direction(c, r, map.width, map.height));
     EXPECT_EQ(map.radiance(world), map.texel(c, r)) << c << "," << r;
   }
@@ -155,8 +155,8 @@ TEST(EnvironmentMap, RadianceInterpolatesWrapsAndClamps) {
   const auto at = [&](double u, double v) { return map.radiance(latlong_direction(u, v, 16, 8)); };
   const auto near = [](glm::vec3 a, glm::vec3 b) { return glm::distance(a, b) < 1e-3f * glm::length(b); };
   // Halfway between the centres of columns 3 and 4 of row 2, a quarter down towards row 3.
-  const glm::vec3 expected = 0.75f * (0.5f * (map.texel(3, 2) + map.texel(4, 2))) +
-                             0.25f * (0.5f * (map.texel(3, 3) + map.texel(4, 3)));
+  const glm::vec3 expected =
+      0.75f * (0.5f * (map.texel(3, 2) + map.texel(4, 2))) + 0.25f * (0.5f * (map.texel(3, 3) + map.texel(4, 3)));
   EXPECT_TRUE(near(at(4.0, 2.75), expected));
   // u = 0 is halfway between the last column and the first.
   EXPECT_TRUE(near(at(0.0, 4.5), 0.5f * (map.texel(15, 4) + map.texel(0, 4))));

@@ -177,7 +177,8 @@ TEST(Mesh, ObjQuadsAreTriangulatedWithAreaWeightedNormals) {
       expected = glm::normalize(glm::vec3(0, float(floor_area), float(-wall_area)));
       EXPECT_GT(wall_area, floor_area) << "the wall's triangles are three times larger";
     }
-    EXPECT_NEAR(glm::distance(mesh.normals[v], expected), 0.f, 1e-6f) << "vertex at " << p.x << "," << p.y << "," << p.z;
+    EXPECT_NEAR(glm::distance(mesh.normals[v], expected), 0.f, 1e-6f)
+        << "vertex at " << p.x << "," << p.y << "," << p.z;
   }
 }
 

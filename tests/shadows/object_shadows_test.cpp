@@ -11,8 +11,8 @@
 
 #include "lumar/base/error.h"
 #include "lumar/lighting/ray_scene.h"
-#include "lumar/scene/scene.h"
 #include "lumar/lighting/shadows/shadow_methods.h"
+#include "lumar/scene/scene.h"
 #include "test_geometry.h"
 #include "test_paths.h"
 
@@ -231,7 +231,8 @@ TEST(ObjectShadows, SlowMotionWalksFromLastBlockers) {
   const glm::dmat4 T_a = glm::scale(translation(0, 0.1, 0), glm::dvec3(0.1));
   const Emitters emitters = suns({{1, 0.15f, 0}, {-1, 0.25f, 0.05f}, {0.2f, 1, 0.1f}, {0.6f, 0.5f, -0.4f}});
   const auto pose_b = [](double x) {
-    return glm::rotate(translation(x, 0.14, 0.02), 3.0 * x, glm::dvec3(0.2, 1, 0)) * glm::scale(glm::dmat4(1.0), glm::dvec3(0.12));
+    return glm::rotate(translation(x, 0.14, 0.02), 3.0 * x, glm::dvec3(0.2, 1, 0)) *
+           glm::scale(glm::dmat4(1.0), glm::dvec3(0.12));
   };
   ObjectShadows moving(emitters);
   const int a = moving.add_object(ball, T_a), b = moving.add_object(ball, pose_b(0.3));
@@ -242,13 +243,16 @@ TEST(ObjectShadows, SlowMotionWalksFromLastBlockers) {
     ObjectShadows fresh(emitters);
     fresh.add_object(ball, T_a), fresh.add_object(ball, pose_b(x));
     fresh.update();
-    for (const int id : {a, b}) EXPECT_EQ(moving.vertex_attenuation(id), fresh.vertex_attenuation(id)) << "update " << k;
+    for (const int id : {a, b})
+      EXPECT_EQ(moving.vertex_attenuation(id), fresh.vertex_attenuation(id)) << "update " << k;
     const ObjectShadowStats& st = moving.stats();
     EXPECT_EQ(st.lines_blocked, fresh.stats().lines_blocked);
     std::printf("update %d: %zu lines blocked, %zu proven by walks\n", k, st.lines_blocked, st.lines_walked);
     EXPECT_GT(st.lines_blocked, 50u);
-    if (k == 0 || k == 6) EXPECT_EQ(st.lines_walked, 0u);
-    else EXPECT_GT(double(st.lines_walked), 0.5 * double(st.lines_blocked)) << "update " << k;
+    if (k == 0 || k == 6)
+      EXPECT_EQ(st.lines_walked, 0u);
+    else
+      EXPECT_GT(double(st.lines_walked), 0.5 * double(st.lines_blocked)) << "update " << k;
   }
 }
 

@@ -3,10 +3,10 @@
 // manifest's floor receivers (`receiver_vertices` of them), its emitters, and the lines.
 #include <memory>
 
-#include "lumar/scene/mesh.h"
-#include "lumar/scene/scene.h"
 #include "lumar/lighting/shadows/shadow_lines.h"
 #include "lumar/lighting/shadows/shadow_methods.h"
+#include "lumar/scene/mesh.h"
+#include "lumar/scene/scene.h"
 
 namespace lumar::test {
 

@@ -6,8 +6,8 @@
 
 #include <glm/gtc/matrix_transform.hpp>
 
-#include "lumar/scene/scene.h"
 #include "lumar/lighting/shadows/shadow_methods.h"
+#include "lumar/scene/scene.h"
 #include "shadow_test_util.h"
 #include "test_paths.h"
 
@@ -39,10 +39,11 @@ void check_against_reference(const ShadowScene& scene, const Case& k, const char
   const test::ShadowError el = test::shadow_error(lines, ref), es = test::shadow_error(sphere, ref);
   double darkest = 1;
   for (const auto& a : ref) darkest = std::min(darkest, double(a.g));
-  std::printf("%s: %zu points, darkest reference %.3f; lines: shadowed %.4f (%zu ch) lit %.5f (%zu ch); "
-              "2004 sphere: shadowed %.4f lit %.5f\n",
-              what, k.positions.size(), darkest, el.mean_shadowed, el.shadowed, el.mean_lit, el.lit,
-              es.mean_shadowed, es.mean_lit);
+  std::printf(
+      "%s: %zu points, darkest reference %.3f; lines: shadowed %.4f (%zu ch) lit %.5f (%zu ch); "
+      "2004 sphere: shadowed %.4f lit %.5f\n",
+      what, k.positions.size(), darkest, el.mean_shadowed, el.shadowed, el.mean_lit, el.lit, es.mean_shadowed,
+      es.mean_lit);
   ::testing::Test::RecordProperty(std::string(what) + "_lines_shadowed", std::to_string(el.mean_shadowed));
   ::testing::Test::RecordProperty(std::string(what) + "_sphere_shadowed", std::to_string(es.mean_shadowed));
   ASSERT_GT(el.shadowed, 30u) << "the case must have a shadow to measure";
@@ -77,9 +78,9 @@ TEST(ShadowAcceptance, DistantSkyWithSun) {
   save_environment_map(path, test::make_sun_sky(512, 50.0, 30.0, 1.5, 20000.0f));
   EnvironmentMap map = load_environment_map(path);
   Scene s = load_scene(test::source_dir() / "data/scenes/room/scene.json");
-  std::vector<ShadowScene::Object> objects{{"figurine", load_mesh(s.objects[0].mesh),
-                                            glm::translate(glm::dmat4(1.0), glm::dvec3(0, 0.15, 0)) *
-                                                s.objects[0].T_world_model}};
+  std::vector<ShadowScene::Object> objects{
+      {"figurine", load_mesh(s.objects[0].mesh),
+       glm::translate(glm::dmat4(1.0), glm::dvec3(0, 0.15, 0)) * s.objects[0].T_world_model}};
   const ShadowScene scene(std::move(map), true, test::make_ground(5.0f), std::move(objects));
   check_against_reference(scene, floor_points_around(scene, 0.0f, 32), "sun");
 }

@@ -11,13 +11,13 @@
 #include <string>
 #include <vector>
 
-#include "lumar/scene/scene.h"
 #include "lumar/lighting/shadows/shadow_cone.h"
 #include "lumar/lighting/shadows/shadow_methods.h"
 #include "lumar/lighting/shadows/shadow_occlusion.h"
 #include "lumar/lighting/shadows/shadow_receiver_grid.h"
-#include "shadow_test_util.h"
+#include "lumar/scene/scene.h"
 #include "sample_room_lines.h"
+#include "shadow_test_util.h"
 #include "test_paths.h"
 
 namespace lumar {
@@ -85,7 +85,8 @@ TEST(ShadowCone, ContainsEveryPointWhoseLineCrossesTheBox) {
         x = distant ? y - (0.5 + 2.0 * unit(rng)) * e : e + (0.8 + 3.0 * unit(rng)) * (y - e);
       }
       // The shadow ray stops just short of the emitter (shadow_ray_t_far).
-      const glm::dvec3 end = x + double(shadow_ray_t_far(distant)) * ((distant ? x + double(kDistantLineLength) * e : e) - x);
+      const glm::dvec3 end =
+          x + double(shadow_ray_t_far(distant)) * ((distant ? x + double(kDistantLineLength) * e : e) - x);
       const bool crosses = box.crossed_by(x, end);
       const bool said = cone.contains(glm::vec3(x));
       ++total;
@@ -152,7 +153,8 @@ std::vector<std::uint32_t> culled_matches_all(LineShadows& shadows, const std::s
   EXPECT_EQ(missed, 0u) << what << ": blocked lines outside the candidates";
   EXPECT_EQ(culled_blocked, blocked) << what;
   float diff = 0;
-  for (std::size_t i = 0; i < culled.size(); ++i) diff = std::max(diff, glm::length(culled[i] - shadows.attenuation()[i]));
+  for (std::size_t i = 0; i < culled.size(); ++i)
+    diff = std::max(diff, glm::length(culled[i] - shadows.attenuation()[i]));
   EXPECT_LT(diff, 1e-5f) << what;
   EXPECT_LT(traced.size(), shadows.lines().lines.size()) << what;
   return blocked;
@@ -197,7 +199,8 @@ TEST(ShadowCulling, CandidatesContainEveryBlockedLine) {
     const glm::dvec3 at(s.movement_min.x + u(rng) * (s.movement_max.x - s.movement_min.x), 0.1 + 0.4 * u(rng),
                         s.movement_min.z + u(rng) * (s.movement_max.z - s.movement_min.z));
     glm::dmat4 T = pose(6.3 * u(rng), at);
-    if (k % 3 == 0) T = glm::translate(glm::dmat4(1.0), glm::dvec3(0, -lowest(T) - 0.002, 0)) * T;  // on the floor, 2 mm in
+    if (k % 3 == 0)
+      T = glm::translate(glm::dmat4(1.0), glm::dvec3(0, -lowest(T) - 0.002, 0)) * T;  // on the floor, 2 mm in
     blocked += check_pose(shadows, T, k % 3 == 0 ? "touching the floor" : "random");
   }
   // Next to the brightest emitter point: the figurine's box centre 8-20 cm from it along
@@ -235,8 +238,10 @@ TEST(ShadowCulling, SlowMotionReusesLastFramesBlockers) {
     EXPECT_EQ(blocked, oracle.blocked_lines()) << "frame " << k;
     const ShadowFrameStats& st = shadows.stats();
     std::printf("frame %d: %zu lines blocked, %zu of them proven by walking\n", k, st.lines_blocked, st.lines_walked);
-    if (k == 0) EXPECT_EQ(st.lines_walked, 0u);  // no last frame
-    else EXPECT_GT(double(st.lines_walked), 0.6 * double(st.lines_blocked)) << "frame " << k;
+    if (k == 0)
+      EXPECT_EQ(st.lines_walked, 0u);  // no last frame
+    else
+      EXPECT_GT(double(st.lines_walked), 0.6 * double(st.lines_blocked)) << "frame " << k;
   }
   // A jump of 0.3 m: no walks (they would all fail), the same lines as tracing all.
   const glm::dmat4 far = glm::translate(glm::dmat4(1.0), glm::dvec3(-0.3, 0.0, 0.0)) * pose(7);

@@ -10,12 +10,12 @@
 #include <random>
 
 #include "lumar/base/error.h"
-#include "lumar/scene/scene.h"
 #include "lumar/lighting/shadows/shadow_methods.h"
 #include "lumar/lighting/shadows/shadow_occlusion.h"
 #include "lumar/lighting/shadows/shadow_receivers.h"
-#include "shadow_test_util.h"
+#include "lumar/scene/scene.h"
 #include "sample_room_lines.h"
+#include "shadow_test_util.h"
 #include "test_paths.h"
 
 namespace lumar {

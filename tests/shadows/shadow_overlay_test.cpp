@@ -12,10 +12,10 @@
 #include <sstream>
 
 #include "lumar/base/color.h"
-#include "lumar/render/compositor.h"
-#include "lumar/render/platform/context.h"
 #include "lumar/lighting/shadows/object_shadows.h"
 #include "lumar/lighting/shadows/shadow_occlusion.h"
+#include "lumar/render/compositor.h"
+#include "lumar/render/platform/context.h"
 #include "test_paths.h"
 
 namespace lumar {
@@ -55,8 +55,7 @@ cv::Mat linear(const cv::Mat& bgr8) {
   cv::Mat out(bgr8.size(), CV_32FC3);
   for (int r = 0; r < bgr8.rows; ++r)
     for (int c = 0; c < bgr8.cols; ++c)
-      for (int k = 0; k < 3; ++k)
-        out.at<cv::Vec3f>(r, c)[k] = srgb_to_linear(bgr8.at<cv::Vec3b>(r, c)[k] / 255.0f);
+      for (int k = 0; k < 3; ++k) out.at<cv::Vec3f>(r, c)[k] = srgb_to_linear(bgr8.at<cv::Vec3b>(r, c)[k] / 255.0f);
   return out;
 }
 
@@ -145,7 +144,8 @@ TEST(ShadowOverlay, VideoDarkensWhereTheLinesSayAndNowhereElse) {
       ++changed;
       EXPECT_LT(int(a[1]), int(b[1])) << "shadows only darken";
       // The floor point this pixel sees (y = 0).
-      const glm::dvec3 ray = pose.rotation_matrix() * glm::dvec3((u - camera.cx) / camera.fx, (v - camera.cy) / camera.fy, 1.0);
+      const glm::dvec3 ray =
+          pose.rotation_matrix() * glm::dvec3((u - camera.cx) / camera.fx, (v - camera.cy) / camera.fy, 1.0);
       bool near_shadow = false;
       if (ray.y < 0) {
         const glm::dvec3 p = eye + (-eye.y / ray.y) * ray;
@@ -197,10 +197,12 @@ TEST(ShadowOverlay, ObjectsShadowEachOther) {
       const glm::vec3 n = glm::cross(b - a, c - a);
       const float area2 = glm::dot(n, n);
       if (!(area2 > 0.0f) || std::abs(glm::dot(x - a, n)) > 5e-4f * std::sqrt(area2)) continue;  // 0.5 mm off its plane
-      const float wa = glm::dot(glm::cross(c - b, x - b), n) / area2, wb = glm::dot(glm::cross(a - c, x - c), n) / area2;
+      const float wa = glm::dot(glm::cross(c - b, x - b), n) / area2,
+                  wb = glm::dot(glm::cross(a - c, x - c), n) / area2;
       const float wc = 1.0f - wa - wb;
       if (std::min({wa, wb, wc}) < -0.02f) continue;
-      return wa * att[lower.indices[3 * t]].g + wb * att[lower.indices[3 * t + 1]].g + wc * att[lower.indices[3 * t + 2]].g;
+      return wa * att[lower.indices[3 * t]].g + wb * att[lower.indices[3 * t + 1]].g +
+             wc * att[lower.indices[3 * t + 2]].g;
     }
     return std::nullopt;
   };
@@ -229,9 +231,10 @@ TEST(ShadowOverlay, ObjectsShadowEachOther) {
   ASSERT_GE(errors.size(), 10u) << "too few shadowed vertices of the lower figurine in view";
   std::sort(errors.begin(), errors.end());
   const double median = errors[errors.size() / 2], p95 = errors[errors.size() * 19 / 20];
-  std::printf("%zu shadowed vertices in view: |pixel ratio - interpolated attenuation| median %.4f, p95 %.4f, max %.4f; "
-              "darkest %.3f\n",
-              errors.size(), median, p95, errors.back(), darkest);
+  std::printf(
+      "%zu shadowed vertices in view: |pixel ratio - interpolated attenuation| median %.4f, p95 %.4f, max %.4f; "
+      "darkest %.3f\n",
+      errors.size(), median, p95, errors.back(), darkest);
   // 8-bit output: half a code is about 1 % of these values. Where a claw folds, several
   // triangles lie within a pixel and the one found may not be the one drawn: a few outliers.
   EXPECT_LT(median, 0.01);

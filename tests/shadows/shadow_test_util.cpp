@@ -56,8 +56,10 @@ ShadowError shadow_error(const std::vector<glm::vec3>& a, const std::vector<glm:
   for (std::size_t i = 0; i < a.size(); ++i)
     for (int c = 0; c < 3; ++c) {
       const double d = std::abs(double(a[i][c]) - ref[i][c]);
-      if (ref[i][c] < 0.98) e.mean_shadowed += d, ++e.shadowed;
-      else e.mean_lit += d, ++e.lit;
+      if (ref[i][c] < 0.98)
+        e.mean_shadowed += d, ++e.shadowed;
+      else
+        e.mean_lit += d, ++e.lit;
     }
   if (e.shadowed) e.mean_shadowed /= double(e.shadowed);
   if (e.lit) e.mean_lit /= double(e.lit);

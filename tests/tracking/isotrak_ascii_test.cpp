@@ -120,22 +120,22 @@ TEST(IsotrakAscii, RejectsMalformedRecordsWhole) {
   const std::string good = "01   12.34  -5.67 100.00-179.99  45.50   0.00\r\n";
   ASSERT_TRUE(decode_ascii_record(good, f).has_value());
   auto with = [&](std::size_t at, const std::string& s) { return std::string(good).replace(at, s.size(), s); };
-  EXPECT_FALSE(decode_ascii_record(with(1, "7"), f));            // station out of range
-  EXPECT_FALSE(decode_ascii_record(with(1, "3"), f));            // ISOTRAK II has two stations
-  EXPECT_TRUE(decode_ascii_record(with(1, "3"), f, 4));          // a Fastrak has four
-  EXPECT_FALSE(decode_ascii_record(with(0, "1"), f));            // not a data record
-  EXPECT_FALSE(decode_ascii_record(with(2, "\t"), f));           // unprintable status
-  EXPECT_FALSE(decode_ascii_record(with(5, "a"), f));            // letter in a digit
-  EXPECT_FALSE(decode_ascii_record(with(3, "  123.4"), f));      // point in the wrong column
-  EXPECT_FALSE(decode_ascii_record(with(3, "       "), f));      // empty field
-  EXPECT_FALSE(decode_ascii_record(with(3, "  - .50"), f));      // no integer digit
-  EXPECT_FALSE(decode_ascii_record(with(3, " --1.50"), f));      // two signs
-  EXPECT_FALSE(decode_ascii_record(with(3, " 1 2.50"), f));      // space among digits
-  EXPECT_FALSE(decode_ascii_record(with(3, "1234.50"), f));      // a digit in the sign column
-  EXPECT_FALSE(decode_ascii_record(with(45, "\n\r"), f));        // wrong terminator
+  EXPECT_FALSE(decode_ascii_record(with(1, "7"), f));        // station out of range
+  EXPECT_FALSE(decode_ascii_record(with(1, "3"), f));        // ISOTRAK II has two stations
+  EXPECT_TRUE(decode_ascii_record(with(1, "3"), f, 4));      // a Fastrak has four
+  EXPECT_FALSE(decode_ascii_record(with(0, "1"), f));        // not a data record
+  EXPECT_FALSE(decode_ascii_record(with(2, "\t"), f));       // unprintable status
+  EXPECT_FALSE(decode_ascii_record(with(5, "a"), f));        // letter in a digit
+  EXPECT_FALSE(decode_ascii_record(with(3, "  123.4"), f));  // point in the wrong column
+  EXPECT_FALSE(decode_ascii_record(with(3, "       "), f));  // empty field
+  EXPECT_FALSE(decode_ascii_record(with(3, "  - .50"), f));  // no integer digit
+  EXPECT_FALSE(decode_ascii_record(with(3, " --1.50"), f));  // two signs
+  EXPECT_FALSE(decode_ascii_record(with(3, " 1 2.50"), f));  // space among digits
+  EXPECT_FALSE(decode_ascii_record(with(3, "1234.50"), f));  // a digit in the sign column
+  EXPECT_FALSE(decode_ascii_record(with(45, "\n\r"), f));    // wrong terminator
   EXPECT_FALSE(decode_ascii_record(with(45, "  "), f));
-  EXPECT_FALSE(decode_ascii_record(good.substr(0, 46), f));      // truncated
-  EXPECT_TRUE(decode_ascii_record(with(2, "@"), f));             // stylus status is fine
+  EXPECT_FALSE(decode_ascii_record(good.substr(0, 46), f));  // truncated
+  EXPECT_TRUE(decode_ascii_record(with(2, "@"), f));         // stylus status is fine
 }
 
 TEST(IsotrakAscii, RoundTripsRandomRecords) {
@@ -172,8 +172,8 @@ TEST(IsotrakAscii, RoundTripsRandomRecords) {
   EXPECT_LE(max_att, 0.005 + 1e-9);
   EXPECT_LE(max_q, 0.00005 + 1e-12);
   EXPECT_GT(max_pos, 0.004);  // the random values really exercised the rounding
-  std::printf("round trip: max |position error| %.6f in, |attitude error| %.6f deg, |q error| %.7f\n", max_pos,
-              max_att, max_q);
+  std::printf("round trip: max |position error| %.6f in, |attitude error| %.6f deg, |q error| %.7f\n", max_pos, max_att,
+              max_q);
 }
 
 // Records for the resynchronisation tests. None of their bytes holds "01" or "02"
@@ -184,25 +184,25 @@ std::string rec(int station, double x) {
 }
 
 TEST(IsotrakAscii, ResynchronisesWithExactCounts) {
-  const std::string r1 = rec(1, 12.34), r2 = rec(2, 56.78), r3 = rec(1, 9.87), r4 = rec(2, 43.21),
-                    r5 = rec(1, 87.65), r6 = rec(2, 77.77);
+  const std::string r1 = rec(1, 12.34), r2 = rec(2, 56.78), r3 = rec(1, 9.87), r4 = rec(2, 43.21), r5 = rec(1, 87.65),
+                    r6 = rec(2, 77.77);
   for (const auto& r : {r1, r2, r3, r4, r5, r6}) {
     ASSERT_EQ(r.find("01", 1), std::string::npos);
     ASSERT_EQ(r.find("02", 1), std::string::npos);
   }
   std::string stream;
-  stream += "xyz\xff";                                  // 4 garbage bytes
-  stream += r1;                                         // accepted
-  stream += "0900";                                     // 4 bytes: '0' + bad station, "00" is no start
-  stream += r3.substr(0, 20);                           // torn record: rejected, 20 bytes skipped
-  stream += r2;                                         // accepted (not lost to the torn one)
-  stream += r3.substr(0, 30) + "#" + r3.substr(30);     // byte inside a record: rejected, 48 skipped
-  stream += "07" + r3.substr(2);                        // station 7: 47 skipped, not a candidate
-  stream += r3.substr(0, 10) + "a" + r3.substr(11);     // letter in a field: rejected, 47 skipped
-  stream += r4;                                         // accepted
-  stream += r5.substr(0, 45) + "  ";                    // no CR LF: rejected, 47 skipped
-  stream += r6;                                         // accepted
-  stream += "0";                                        // may start a record: pending
+  stream += "xyz\xff";                               // 4 garbage bytes
+  stream += r1;                                      // accepted
+  stream += "0900";                                  // 4 bytes: '0' + bad station, "00" is no start
+  stream += r3.substr(0, 20);                        // torn record: rejected, 20 bytes skipped
+  stream += r2;                                      // accepted (not lost to the torn one)
+  stream += r3.substr(0, 30) + "#" + r3.substr(30);  // byte inside a record: rejected, 48 skipped
+  stream += "07" + r3.substr(2);                     // station 7: 47 skipped, not a candidate
+  stream += r3.substr(0, 10) + "a" + r3.substr(11);  // letter in a field: rejected, 47 skipped
+  stream += r4;                                      // accepted
+  stream += r5.substr(0, 45) + "  ";                 // no CR LF: rejected, 47 skipped
+  stream += r6;                                      // accepted
+  stream += "0";                                     // may start a record: pending
   AsciiRecordParser parser(kDefault);
   parser.push(chunk_of(stream));
   const auto got = parser.take_all();

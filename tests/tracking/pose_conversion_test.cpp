@@ -70,8 +70,8 @@ TEST(PoseConversion, ParsedAttitudeMatchesHandBuiltMatrix) {
     const auto s = to_pose_sample(rec->record, f, 0);
     ASSERT_TRUE(s.has_value());
     EXPECT_NEAR(glm::length(s->T_transmitter_sensor.rotation), 1.0, 1e-12);
-    worst = std::max(worst, max_abs_diff(glm::mat3_cast(s->T_transmitter_sensor.rotation),
-                                         polhemus_matrix_by_hand(a.x, a.y, a.z)));
+    worst = std::max(
+        worst, max_abs_diff(glm::mat3_cast(s->T_transmitter_sensor.rotation), polhemus_matrix_by_hand(a.x, a.y, a.z)));
     ++n;
   }
   EXPECT_EQ(n, 1000);
@@ -82,8 +82,8 @@ TEST(PoseConversion, ParsedAttitudeMatchesHandBuiltMatrix) {
 TEST(PoseConversion, PrefersTheQuaternionItemAndRenormalisesIt) {
   IsotrakRecord r;
   r.position = glm::dvec3(0.0);
-  r.attitude_deg = glm::dvec3(90.0, 0.0, 0.0);                // disagrees on purpose
-  r.quaternion = glm::dquat(0.7071, 0.7071, 0.0, 0.0);         // 90 deg about x, 4 decimals
+  r.attitude_deg = glm::dvec3(90.0, 0.0, 0.0);          // disagrees on purpose
+  r.quaternion = glm::dquat(0.7071, 0.7071, 0.0, 0.0);  // 90 deg about x, 4 decimals
   const auto s = to_pose_sample(r, OutputFormat{}, 0);
   ASSERT_TRUE(s.has_value());
   const glm::dquat q = s->T_transmitter_sensor.rotation;

@@ -41,8 +41,8 @@ TEST(RecordCodec, RecordLengths) {
   EXPECT_EQ(record_length(TrackerFormat::of(Device::Isotrak2)), 47);
   EXPECT_EQ(record_length(TrackerFormat::of(Device::Fastrak, false, list({2, 11, 1}))), 54);
   // ISOTRAK II binary: 3 + 2 per value payload bytes, plus one top-bit byte per 7.
-  EXPECT_EQ(record_length(TrackerFormat::of(Device::Isotrak2, true, list({2, 11}))), 20);   // 17 + 3
-  EXPECT_EQ(record_length(TrackerFormat::of(Device::Isotrak2, true, list({2, 4}))), 18);    // 15 + 3
+  EXPECT_EQ(record_length(TrackerFormat::of(Device::Isotrak2, true, list({2, 11}))), 20);     // 17 + 3
+  EXPECT_EQ(record_length(TrackerFormat::of(Device::Isotrak2, true, list({2, 4}))), 18);      // 15 + 3
   EXPECT_EQ(record_length(TrackerFormat::of(Device::Isotrak2, true, list({2, 4, 11}))), 27);  // 23 + 4
   EXPECT_EQ(record_length(TrackerFormat::of(Device::Isotrak2, true, list({2, 11, 1}))), 20);  // no separators
   EXPECT_EQ(record_length(TrackerFormat::of(Device::Isotrak2, true, list({0, 2, 11, 1}))), 20);
@@ -126,14 +126,14 @@ TEST(RecordCodec, IsotrakBinaryRejectsBrokenFraming) {
     b[at] = v;
     return b;
   };
-  EXPECT_FALSE(decode_record(with(0, 0x30), f));  // no start mark
-  EXPECT_FALSE(decode_record(with(5, 0xFF), f));  // bit 7 inside the record
-  EXPECT_FALSE(decode_record(with(1, 0x33), f));  // station 3 on an ISOTRAK II
-  EXPECT_FALSE(decode_record(with(2, 0x09), f));  // unprintable status
-  EXPECT_FALSE(decode_record(with(7, 0x69), f));  // top bit for '0' makes it 0xB0
-  EXPECT_FALSE(decode_record(with(19, 0x0A), f));  // top bit for a byte the short group lacks
+  EXPECT_FALSE(decode_record(with(0, 0x30), f));                        // no start mark
+  EXPECT_FALSE(decode_record(with(5, 0xFF), f));                        // bit 7 inside the record
+  EXPECT_FALSE(decode_record(with(1, 0x33), f));                        // station 3 on an ISOTRAK II
+  EXPECT_FALSE(decode_record(with(2, 0x09), f));                        // unprintable status
+  EXPECT_FALSE(decode_record(with(7, 0x69), f));                        // top bit for '0' makes it 0xB0
+  EXPECT_FALSE(decode_record(with(19, 0x0A), f));                       // top bit for a byte the short group lacks
   EXPECT_FALSE(decode_record(Bytes(good.begin(), good.end() - 1), f));  // truncated
-  EXPECT_TRUE(decode_record(with(4, 0x05), f));   // a changed value is still a record
+  EXPECT_TRUE(decode_record(with(4, 0x05), f));                         // a changed value is still a record
 }
 
 TEST(RecordCodec, FastrakBinaryMatchesHandComputedBytes) {
@@ -143,9 +143,9 @@ TEST(RecordCodec, FastrakBinaryMatchesHandComputedBytes) {
   r.status = 'E';
   r.position = glm::dvec3(1.0, -2.5, 0.0);
   r.quaternion = glm::dquat(1.0, 0.0, -0.5, 0.5);
-  const Bytes expected = {'0',  '4',  'E',                                            //
+  const Bytes expected = {'0',  '4',  'E',                                             //
                           0x00, 0x00, 0x80, 0x3F, 0x00, 0x00, 0x20, 0xC0, 0, 0, 0, 0,  //
-                          0x00, 0x00, 0x80, 0x3F, 0, 0, 0, 0,                          //
+                          0x00, 0x00, 0x80, 0x3F, 0,    0,    0,    0,                 //
                           0x00, 0x00, 0x00, 0xBF, 0x00, 0x00, 0x00, 0x3F,              //
                           ' '};
   const TrackerFormat f = TrackerFormat::of(Device::Fastrak, true, list({2, 11, 0}));
@@ -183,7 +183,7 @@ TEST(RecordCodec, EncoderRefusesWhatDoesNotFit) {
   EXPECT_THROW(encode_record(r, ib), std::invalid_argument);
   r.attitude_deg->z = 0;
   r.station = 3;
-  EXPECT_THROW(encode_record(r, ib), std::invalid_argument);             // ISOTRAK II: 2 stations
+  EXPECT_THROW(encode_record(r, ib), std::invalid_argument);              // ISOTRAK II: 2 stations
   EXPECT_NO_THROW(encode_record(r, TrackerFormat::of(Device::Fastrak)));  // Fastrak: 4
   r.station = 5;
   EXPECT_THROW(encode_record(r, TrackerFormat::of(Device::Fastrak)), std::invalid_argument);
@@ -299,8 +299,7 @@ TEST_P(RoundTrip, DecodesWithinQuantisation) {
   }
   std::printf("%s %s %s list", device_name(device).c_str(), binary ? "binary" : "ascii", cm ? "cm" : "in");
   for (int item : items) std::printf(" %d", item);
-  std::printf(": %d bytes, max error position %.3g, attitude %.3g deg, quaternion %.3g\n", length, e_pos, e_att,
-              e_q);
+  std::printf(": %d bytes, max error position %.3g, attitude %.3g deg, quaternion %.3g\n", length, e_pos, e_att, e_q);
 }
 
 std::vector<std::tuple<Device, bool, bool, std::vector<int>>> round_trip_cases() {
@@ -432,10 +431,11 @@ TEST_P(Garbage, EveryUntouchedRecordIsRecoveredWithExactCounts) {
   EXPECT_EQ(parser.skipped_bytes(), noisy.size() - parser.accepted_records() * L - expect_pending);
   EXPECT_GT(untouched, std::size_t(n_records) / 2);
   EXPECT_LT(untouched, std::size_t(n_records));
-  std::printf("%s %s, %zu-byte records: %zu bytes replaced, %zu of %d records untouched (all recovered), "
-              "%zu touched but still valid, %zu rejected, %zu bytes skipped\n",
-              device_name(device).c_str(), binary ? "binary" : "ascii", L, replaced, untouched, n_records,
-              touched_but_valid, parser.rejected_records(), parser.skipped_bytes());
+  std::printf(
+      "%s %s, %zu-byte records: %zu bytes replaced, %zu of %d records untouched (all recovered), "
+      "%zu touched but still valid, %zu rejected, %zu bytes skipped\n",
+      device_name(device).c_str(), binary ? "binary" : "ascii", L, replaced, untouched, n_records, touched_but_valid,
+      parser.rejected_records(), parser.skipped_bytes());
 }
 
 std::string garbage_case_name(const ::testing::TestParamInfo<Garbage::ParamType>& info) {

@@ -37,8 +37,8 @@ Recovered parse(const SimulatedTrackerOutput& out, const SimulatedTrackerSetting
   Recovered r;
   for (const auto& c : out.chunks) parser.push(c);
   for (const auto& rec : parser.take_all()) {
-    const auto sample = to_pose_sample(rec.record, s.format,
-                                       measurement_time(rec.first_byte_arrival, s.baud, s.device_latency));
+    const auto sample =
+        to_pose_sample(rec.record, s.format, measurement_time(rec.first_byte_arrival, s.baud, s.device_latency));
     if (sample) r.samples.push_back(*sample);
   }
   r.rejected = parser.rejected_records();
@@ -68,8 +68,8 @@ TEST(SimulatedTracker, NoiseHasTheRequestedSize) {
     EXPECT_NEAR(rms_pos[k], 0.0025, 0.00025) << "axis " << k;
     EXPECT_NEAR(sum_pos[k] / kSamples, 0.0, 0.0002) << "axis " << k;  // unbiased (4 sigma of the mean)
   }
-  std::printf("simulator: RMS orientation error %.4f deg, RMS position error %.5f %.5f %.5f m\n", rms_angle,
-              rms_pos.x, rms_pos.y, rms_pos.z);
+  std::printf("simulator: RMS orientation error %.4f deg, RMS position error %.5f %.5f %.5f m\n", rms_angle, rms_pos.x,
+              rms_pos.y, rms_pos.z);
 }
 
 TEST(SimulatedTracker, ParserRecoversTimesAndPosesWithinQuantisation) {
@@ -89,8 +89,8 @@ TEST(SimulatedTracker, ParserRecoversTimesAndPosesWithinQuantisation) {
     worst_dt = std::max(worst_dt, std::abs(got.time - t_k));
     const glm::dvec3 d = (got.T_transmitter_sensor.translation - measured.T_transmitter_sensor.translation) / 0.0254;
     worst_pos_in = std::max({worst_pos_in, std::abs(d.x), std::abs(d.y), std::abs(d.z)});
-    worst_deg = std::max(worst_deg, rotation_angle_deg(got.T_transmitter_sensor.rotation,
-                                                       measured.T_transmitter_sensor.rotation));
+    worst_deg = std::max(worst_deg,
+                         rotation_angle_deg(got.T_transmitter_sensor.rotation, measured.T_transmitter_sensor.rotation));
     const double a = rotation_angle_deg(got.T_transmitter_sensor.rotation, trajectory(t_k).rotation);
     sum_angle2 += a * a;
   }
@@ -173,7 +173,13 @@ TEST(SimulatedTracker, RefusesUnusableSettings) {
   EXPECT_THROW(simulate_tracker(trajectory, kNanosPerSecond, s), InputError);
   s = {};
   // 30 m is beyond the 999.99 in an ASCII field can hold.
-  EXPECT_THROW(simulate_tracker([](Nanos) { Pose p; p.translation = {30.0, 0, 0}; return p; }, kNanosPerSecond, s),
+  EXPECT_THROW(simulate_tracker(
+                   [](Nanos) {
+                     Pose p;
+                     p.translation = {30.0, 0, 0};
+                     return p;
+                   },
+                   kNanosPerSecond, s),
                std::invalid_argument);
 }
 

@@ -55,7 +55,7 @@ inline Tolerance quantisation(const TrackerFormat& f) {
   if (!f.binary) return {0.005 * unit_m + 1e-9, 0.016};  // 2 decimals; 3 angles of +-0.005 deg or 4 decimals
   if (f.device == Device::Isotrak2)
     return {0.5 * 1.6632 / 32767 + 1e-9, 0.01};  // half a count of 166.32 cm / 32767; int16 angles
-  return {1e-6, 0.001};                         // float32
+  return {1e-6, 0.001};                          // float32
 }
 
 inline bool has_item(const TrackerFormat& f, int item) {
@@ -70,8 +70,8 @@ inline Pose expected_pose(const SentRecord& r) {
   if (has_item(r.format, kItemQuaternion))
     p.rotation = *r.values.quaternion;
   else
-    p.rotation = polhemus_attitude_to_quat(r.values.attitude_deg->x, r.values.attitude_deg->y,
-                                           r.values.attitude_deg->z);
+    p.rotation =
+        polhemus_attitude_to_quat(r.values.attitude_deg->x, r.values.attitude_deg->y, r.values.attitude_deg->z);
   return p;
 }
 

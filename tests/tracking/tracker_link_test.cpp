@@ -75,8 +75,8 @@ TEST_P(CleanLink, EveryRecordArrivesWithItsValues) {
     worst.position_m = std::max(worst.position_m, m.position_m);
     worst.angle_deg = std::max(worst.angle_deg, m.angle_deg);
     EXPECT_EQ(got[i].station, sent[i].values.station) << "record " << i;
-    EXPECT_TRUE(within(sent[i], got[i])) << "record " << i << ": position off by " << m.position_m
-                                         << " m, rotation by " << m.angle_deg << " deg";
+    EXPECT_TRUE(within(sent[i], got[i])) << "record " << i << ": position off by " << m.position_m << " m, rotation by "
+                                         << m.angle_deg << " deg";
     time_error_ms.push_back(nanos_to_seconds(got[i].time - sent[i].measured) * 1e3);
     ++per_station[std::size_t(got[i].station)];
   }
@@ -93,25 +93,25 @@ TEST_P(CleanLink, EveryRecordArrivesWithItsValues) {
   const double median = time_error_ms[time_error_ms.size() / 2];
   EXPECT_GE(time_error_ms.front(), -0.01);
   EXPECT_LT(median, 20.0);
-  std::printf("  %zu records sent, %zu received; worst error %.2e m, %.4f deg; time error ms: min %.3f median %.3f "
-              "max %.3f; skipped %llu bytes\n",
-              sent.size(), got.size(), worst.position_m, worst.angle_deg, time_error_ms.front(), median,
-              time_error_ms.back(), (unsigned long long)link.status().skipped_bytes);
+  std::printf(
+      "  %zu records sent, %zu received; worst error %.2e m, %.4f deg; time error ms: min %.3f median %.3f "
+      "max %.3f; skipped %llu bytes\n",
+      sent.size(), got.size(), worst.position_m, worst.angle_deg, time_error_ms.front(), median, time_error_ms.back(),
+      (unsigned long long)link.status().skipped_bytes);
 }
 
-INSTANTIATE_TEST_SUITE_P(
-    Formats, CleanLink,
-    testing::Values(LinkCase{Device::Isotrak2, false, false, {2, 4, 1}, {1}},
-                    LinkCase{Device::Isotrak2, false, true, {2, 4, 1}, {1, 2}},
-                    LinkCase{Device::Isotrak2, false, false, {2, 11, 1}, {1}},
-                    LinkCase{Device::Isotrak2, false, true, {2, 11, 1}, {1}},
-                    LinkCase{Device::Isotrak2, true, false, {2, 4, 1}, {1}},
-                    LinkCase{Device::Isotrak2, true, true, {2, 4, 1}, {1}},
-                    LinkCase{Device::Isotrak2, true, false, {2, 11, 1}, {1, 2}},
-                    LinkCase{Device::Isotrak2, true, true, {2, 11, 1}, {1}},
-                    LinkCase{Device::Fastrak, false, true, {2, 11, 1}, {1, 2}},
-                    LinkCase{Device::Fastrak, true, false, {2, 4, 1}, {1, 2}}),
-    case_name);
+INSTANTIATE_TEST_SUITE_P(Formats, CleanLink,
+                         testing::Values(LinkCase{Device::Isotrak2, false, false, {2, 4, 1}, {1}},
+                                         LinkCase{Device::Isotrak2, false, true, {2, 4, 1}, {1, 2}},
+                                         LinkCase{Device::Isotrak2, false, false, {2, 11, 1}, {1}},
+                                         LinkCase{Device::Isotrak2, false, true, {2, 11, 1}, {1}},
+                                         LinkCase{Device::Isotrak2, true, false, {2, 4, 1}, {1}},
+                                         LinkCase{Device::Isotrak2, true, true, {2, 4, 1}, {1}},
+                                         LinkCase{Device::Isotrak2, true, false, {2, 11, 1}, {1, 2}},
+                                         LinkCase{Device::Isotrak2, true, true, {2, 11, 1}, {1}},
+                                         LinkCase{Device::Fastrak, false, true, {2, 11, 1}, {1, 2}},
+                                         LinkCase{Device::Fastrak, true, false, {2, 4, 1}, {1, 2}}),
+                         case_name);
 
 // 1 % of the bytes replaced by garbage: every record garbage did not touch is recovered.
 TEST(FaultyLink, GarbageLosesOnlyTheRecordsItTouches) {
@@ -148,10 +148,11 @@ TEST(FaultyLink, GarbageLosesOnlyTheRecordsItTouches) {
     (sent[k].garbage_bytes == 0 ? matched_intact : matched_damaged) += 1;
     cursor = k + 1;
   }
-  std::printf("  %zu records sent (%zu bytes of garbage in %zu of them), %zu intact; received %zu: %zu intact, %zu "
-              "damaged but equal, %zu altered; driver: %llu rejected candidates, %llu skipped bytes\n",
-              sent.size(), garbage, damaged, good.size(), got.size(), matched_intact, matched_damaged, unmatched,
-              (unsigned long long)link.status().rejected_records, (unsigned long long)link.status().skipped_bytes);
+  std::printf(
+      "  %zu records sent (%zu bytes of garbage in %zu of them), %zu intact; received %zu: %zu intact, %zu "
+      "damaged but equal, %zu altered; driver: %llu rejected candidates, %llu skipped bytes\n",
+      sent.size(), garbage, damaged, good.size(), got.size(), matched_intact, matched_damaged, unmatched,
+      (unsigned long long)link.status().rejected_records, (unsigned long long)link.status().skipped_bytes);
   EXPECT_GT(damaged, 50u) << "the fault injection did not bite";
   EXPECT_EQ(matched_intact, good.size()) << "every untouched record must be recovered";
   EXPECT_LE(matched_damaged + unmatched, damaged);

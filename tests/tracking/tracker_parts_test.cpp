@@ -90,7 +90,7 @@ TEST(Trajectory, CsvIsInterpolatedAndLooped) {
   EXPECT_NEAR(mid.translation.x, 0.5, 1e-12);
   EXPECT_NEAR(rotation_angle_deg(mid.rotation, glm::dquat(1, 0, 0, 0)), 45, 1e-9);
   EXPECT_NEAR(t(1, 1'250'000'000).translation.x, 0.25, 1e-12);  // looped
-  EXPECT_NEAR(t(2, 250'000'000).translation.x, 0.25, 1e-12);     // station 2 follows station 1
+  EXPECT_NEAR(t(2, 250'000'000).translation.x, 0.25, 1e-12);    // station 2 follows station 1
 
   {
     std::ofstream out(dir / "bad.csv");

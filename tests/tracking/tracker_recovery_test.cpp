@@ -1,8 +1,8 @@
 // The driver against a device that vanishes, hangs, or was left streaming, and the
 // transport's deadlines. Every wait has a deadline; the tests measure how long the
 // calls a render loop makes can block.
-#include <gtest/gtest.h>
 #include <fcntl.h>
+#include <gtest/gtest.h>
 #include <sys/ioctl.h>
 #include <unistd.h>
 
@@ -63,11 +63,11 @@ TEST(TrackerRecovery, ReconnectsAfterThePortVanishes) {
   link.finish();
 
   const Nanos bound = ds.watchdog + reset_time(ds, es.rate_hz);
-  std::printf("  port back -> records flowing again: %.1f ms (bound: watchdog + reset = %.1f ms); vanished %llu, "
-              "connects %llu; max take_samples %.3f ms, status %.3f ms; stop %.1f ms\n",
-              ms(reconnect), ms(bound), (unsigned long long)link.status().vanished,
-              (unsigned long long)link.status().connects, ms(link.max_take_time()), ms(link.max_status_time()),
-              ms(link.stop_time()));
+  std::printf(
+      "  port back -> records flowing again: %.1f ms (bound: watchdog + reset = %.1f ms); vanished %llu, "
+      "connects %llu; max take_samples %.3f ms, status %.3f ms; stop %.1f ms\n",
+      ms(reconnect), ms(bound), (unsigned long long)link.status().vanished, (unsigned long long)link.status().connects,
+      ms(link.max_take_time()), ms(link.max_status_time()), ms(link.stop_time()));
   EXPECT_LT(reconnect, bound);
   EXPECT_GE(link.status().vanished, 1u);
   EXPECT_EQ(link.status().connects, 2u);
@@ -83,8 +83,7 @@ TEST(TrackerRecovery, ReconnectsAfterThePortVanishes) {
   const std::size_t after = got.size() - at_back;
   ASSERT_GE(after, 10u);
   ASSERT_GE(sent.size(), after);
-  for (std::size_t i = 0; i < after; ++i)
-    EXPECT_TRUE(within(sent[sent.size() - after + i], got[at_back + i])) << i;
+  for (std::size_t i = 0; i < after; ++i) EXPECT_TRUE(within(sent[sent.size() - after + i], got[at_back + i])) << i;
 }
 
 TEST(TrackerRecovery, AHungDeviceIsResetWithRisingForce) {
@@ -97,7 +96,7 @@ TEST(TrackerRecovery, AHungDeviceIsResetWithRisingForce) {
   const std::size_t before = link.samples().size();
   const Nanos hung = monotonic_now();
   link.emulator().silence_for(60'000'000'000);  // only Ctrl-Y brings it back
-  Nanos first_new = 0;  // when the first sample measured after the hang was taken
+  Nanos first_new = 0;                          // when the first sample measured after the hang was taken
   ASSERT_TRUE(link.run_until(
       [&] {
         if (!first_new && !link.samples().empty() && link.samples().back().time > hung) first_new = monotonic_now();
@@ -110,11 +109,12 @@ TEST(TrackerRecovery, AHungDeviceIsResetWithRisingForce) {
   link.shut_down();
 
   const auto counters = link.emulator().counters();
-  std::printf("  hung -> records again after %.1f ms; watchdog faults %llu, failed resets %llu, Ctrl-Y %llu, highest "
-              "reset level %d; max take_samples %.3f ms, status %.3f ms\n",
-              ms(recovered), (unsigned long long)link.status().watchdog_faults,
-              (unsigned long long)link.status().reset_attempts, (unsigned long long)counters.reinits,
-              link.max_reset_level(), ms(link.max_take_time()), ms(link.max_status_time()));
+  std::printf(
+      "  hung -> records again after %.1f ms; watchdog faults %llu, failed resets %llu, Ctrl-Y %llu, highest "
+      "reset level %d; max take_samples %.3f ms, status %.3f ms\n",
+      ms(recovered), (unsigned long long)link.status().watchdog_faults,
+      (unsigned long long)link.status().reset_attempts, (unsigned long long)counters.reinits, link.max_reset_level(),
+      ms(link.max_take_time()), ms(link.max_status_time()));
   // Watchdog, three resets (each at most quiet_limit + status_timeout), the Ctrl-Y wait,
   // configuration and a record.
   EXPECT_LT(recovered, ds.watchdog + 3 * (ds.quiet_limit + ds.status_timeout) + ds.reinit_wait + 200'000'000);

@@ -51,11 +51,16 @@ std::string uart_type(const std::string& path) {
   ::close(fd);
   if (!ok || info.type == PORT_UNKNOWN) return "";
   switch (info.type) {
-    case PORT_8250: return "8250 UART";
-    case PORT_16450: return "16450 UART";
-    case PORT_16550: return "16550 UART";
-    case PORT_16550A: return "16550A UART";
-    default: return "UART type " + std::to_string(info.type);
+    case PORT_8250:
+      return "8250 UART";
+    case PORT_16450:
+      return "16450 UART";
+    case PORT_16550:
+      return "16550 UART";
+    case PORT_16550A:
+      return "16550A UART";
+    default:
+      return "UART type " + std::to_string(info.type);
   }
 }
 
@@ -83,19 +88,26 @@ std::vector<SerialPortInfo> list_serial_ports() {
 std::optional<std::string> polhemus_model(std::uint16_t vendor, std::uint16_t product) {
   if (vendor != kPolhemusVendor) return std::nullopt;
   switch (product) {
-    case 0x0002: return "Polhemus Fastrak";
-    case 0xef12: return "Polhemus Patriot";
-    case 0xff12: return "Polhemus Liberty";
+    case 0x0002:
+      return "Polhemus Fastrak";
+    case 0xef12:
+      return "Polhemus Patriot";
+    case 0xff12:
+      return "Polhemus Liberty";
   }
   return "Polhemus device 0x" + hex4(product);
 }
 
 std::optional<std::string> usb_serial_vendor(std::uint16_t vendor) {
   switch (vendor) {
-    case 0x0403: return "FTDI";
-    case 0x067b: return "Prolific";
-    case 0x1a86: return "CH340";
-    case 0x10c4: return "Silicon Labs CP210x";
+    case 0x0403:
+      return "FTDI";
+    case 0x067b:
+      return "Prolific";
+    case 0x1a86:
+      return "CH340";
+    case 0x10c4:
+      return "Silicon Labs CP210x";
   }
   return std::nullopt;
 }

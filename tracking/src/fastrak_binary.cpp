@@ -20,11 +20,15 @@ constexpr double kMaxQuaternion = 1.0 + 1e-6;
 
 int item_length(int item) {
   switch (item) {
-    case kItemSpace: return 1;
-    case kItemCrLf: return 2;
+    case kItemSpace:
+      return 1;
+    case kItemCrLf:
+      return 2;
     case kItemPosition:
-    case kItemAttitude: return 3 * 4;
-    case kItemQuaternion: return 4 * 4;
+    case kItemAttitude:
+      return 3 * 4;
+    case kItemQuaternion:
+      return 4 * 4;
   }
   return 0;
 }
@@ -39,8 +43,8 @@ void put_float(std::vector<std::uint8_t>& out, double value, double limit, const
 }
 
 std::optional<double> get_float(const std::uint8_t* p, double limit) {
-  const std::uint32_t bits = std::uint32_t(p[0]) | std::uint32_t(p[1]) << 8 | std::uint32_t(p[2]) << 16 |
-                             std::uint32_t(p[3]) << 24;
+  const std::uint32_t bits =
+      std::uint32_t(p[0]) | std::uint32_t(p[1]) << 8 | std::uint32_t(p[2]) << 16 | std::uint32_t(p[3]) << 24;
   const float f = std::bit_cast<float>(bits);
   if (!std::isfinite(f) || std::abs(f) > limit) return std::nullopt;
   return double(f);
@@ -74,7 +78,9 @@ std::vector<std::uint8_t> encode_fastrak_binary(const IsotrakRecord& r, const Tr
   };
   for (int item : format.output.output_list) {
     switch (item) {
-      case kItemSpace: out.push_back(' '); break;
+      case kItemSpace:
+        out.push_back(' ');
+        break;
       case kItemCrLf:
         out.push_back('\r');
         out.push_back('\n');

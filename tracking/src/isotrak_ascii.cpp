@@ -14,18 +14,22 @@ namespace lumar::tracking {
 namespace {
 
 constexpr int kFieldWidth = 7;
-using detail::kHeaderLength;
 using detail::is_printable;
+using detail::kHeaderLength;
 constexpr int kPositionDecimals = 2;    // "Sxxx.xx"
 constexpr int kQuaternionDecimals = 4;  // "Sx.xxxx"
 
 int item_length(int item) {
   switch (item) {
-    case kItemSpace: return 1;
-    case kItemCrLf: return 2;
+    case kItemSpace:
+      return 1;
+    case kItemCrLf:
+      return 2;
     case kItemPosition:
-    case kItemAttitude: return 3 * kFieldWidth;
-    case kItemQuaternion: return 4 * kFieldWidth;
+    case kItemAttitude:
+      return 3 * kFieldWidth;
+    case kItemQuaternion:
+      return 4 * kFieldWidth;
   }
   return 0;  // unreachable after validate_output_format
 }
@@ -35,8 +39,7 @@ double decimal_scale(int decimals) { return decimals == kPositionDecimals ? 100.
 // Right-justified like printf("%7.<decimals>f"), '-' only for values that do not
 // round to zero. Seven characters hold a sign, five digits and the point.
 void append_field(std::string& out, double v, int decimals, const char* what) {
-  if (!std::isfinite(v))
-    throw std::invalid_argument(std::string("ISOTRAK ASCII encoder: ") + what + " is not finite");
+  if (!std::isfinite(v)) throw std::invalid_argument(std::string("ISOTRAK ASCII encoder: ") + what + " is not finite");
   const double scaled = std::round(std::abs(v) * decimal_scale(decimals));
   if (scaled >= 100000.0)
     throw std::invalid_argument(std::string("ISOTRAK ASCII encoder: ") + what + " " + std::to_string(v) +
@@ -108,8 +111,7 @@ std::string encode_ascii_record(const IsotrakRecord& r, const OutputFormat& form
   if (r.station < 1 || r.station > 9)
     throw std::invalid_argument("ISOTRAK ASCII encoder: station " + std::to_string(r.station) +
                                 " is not a single digit 1..9");
-  if (!is_printable(r.status))
-    throw std::invalid_argument("ISOTRAK ASCII encoder: status byte is not printable ASCII");
+  if (!is_printable(r.status)) throw std::invalid_argument("ISOTRAK ASCII encoder: status byte is not printable ASCII");
   out += '0';
   out += char('0' + r.station);
   out += r.status;
@@ -119,8 +121,12 @@ std::string encode_ascii_record(const IsotrakRecord& r, const OutputFormat& form
   };
   for (int item : format.output_list) {
     switch (item) {
-      case kItemSpace: out += ' '; break;
-      case kItemCrLf: out += "\r\n"; break;
+      case kItemSpace:
+        out += ' ';
+        break;
+      case kItemCrLf:
+        out += "\r\n";
+        break;
       case kItemPosition:
         if (!r.position) throw missing("position");
         for (int k = 0; k < 3; ++k) append_field(out, (*r.position)[k], kPositionDecimals, "position");
@@ -140,8 +146,7 @@ std::string encode_ascii_record(const IsotrakRecord& r, const OutputFormat& form
   return out;
 }
 
-std::optional<IsotrakRecord> decode_ascii_record(std::string_view bytes, const OutputFormat& format,
-                                                 int max_station) {
+std::optional<IsotrakRecord> decode_ascii_record(std::string_view bytes, const OutputFormat& format, int max_station) {
   if (bytes.size() != std::size_t(ascii_record_length(format))) return std::nullopt;
   if (!detail::header_ok(bytes[0], bytes[1], bytes[2], std::clamp(max_station, 0, 9))) return std::nullopt;
   IsotrakRecord r;

@@ -85,9 +85,7 @@ std::optional<std::vector<std::uint8_t>> unpack_7bit(std::span<const std::uint8_
   return payload;
 }
 
-int isotrak_binary_record_length(const TrackerFormat& format) {
-  return packed_length(payload_length(format.output));
-}
+int isotrak_binary_record_length(const TrackerFormat& format) { return packed_length(payload_length(format.output)); }
 
 std::vector<std::uint8_t> encode_isotrak_binary(const IsotrakRecord& r, const TrackerFormat& format) {
   check_header(r.station, r.status, format.max_station, "ISOTRAK II binary encoder");
@@ -112,7 +110,8 @@ std::vector<std::uint8_t> encode_isotrak_binary(const IsotrakRecord& r, const Tr
         for (double c : {q.w, q.x, q.y, q.z}) put_count(payload, c, kQuaternionStep, "quaternion");
         break;
       }
-      default: break;  // space and CR LF: no bytes in a binary record
+      default:
+        break;  // space and CR LF: no bytes in a binary record
     }
   }
   return pack_7bit(payload);
@@ -148,7 +147,8 @@ std::optional<IsotrakRecord> decode_isotrak_binary(std::span<const std::uint8_t>
         at += 8;
         break;
       }
-      default: break;
+      default:
+        break;
     }
   }
   return r;

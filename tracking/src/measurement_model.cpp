@@ -39,8 +39,7 @@ Pose MeasurementNoise::apply(const Pose& truth) {
   return measured;
 }
 
-IsotrakRecord device_record(const Pose& T_transmitter_sensor, const OutputFormat& format, int station,
-                            char status) {
+IsotrakRecord device_record(const Pose& T_transmitter_sensor, const OutputFormat& format, int station, char status) {
   IsotrakRecord record;
   record.station = station;
   record.status = status;

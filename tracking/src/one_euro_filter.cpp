@@ -18,9 +18,10 @@ double smoothing(double cutoff_hz, double dt) {
 }  // namespace
 
 void validate_one_euro(const OneEuroSettings& s, const char* what) {
-  if (!(std::isfinite(s.min_cutoff_hz) && s.min_cutoff_hz > 0) || !(std::isfinite(s.d_cutoff_hz) && s.d_cutoff_hz > 0) ||
-      !(std::isfinite(s.beta) && s.beta >= 0))
-    throw InputError(std::string(what) + ": One Euro cutoffs must be > 0 Hz and beta >= 0; e.g. min_cutoff 1, beta 0.5, d_cutoff 1");
+  if (!(std::isfinite(s.min_cutoff_hz) && s.min_cutoff_hz > 0) ||
+      !(std::isfinite(s.d_cutoff_hz) && s.d_cutoff_hz > 0) || !(std::isfinite(s.beta) && s.beta >= 0))
+    throw InputError(std::string(what) +
+                     ": One Euro cutoffs must be > 0 Hz and beta >= 0; e.g. min_cutoff 1, beta 0.5, d_cutoff 1");
 }
 
 OneEuroPoseFilter::OneEuroPoseFilter(PoseFilterSettings settings) : settings_(settings) {

@@ -38,12 +38,18 @@ std::optional<Pose> PoseStream::at(Nanos t, int station, Nanos max_gap) const {
 
 const char* to_string(PoseStatus status) {
   switch (status) {
-    case PoseStatus::Interpolated: return "interpolated";
-    case PoseStatus::Extrapolated: return "extrapolated";
-    case PoseStatus::NoSamples: return "no samples";
-    case PoseStatus::BeforeFirst: return "before the first sample";
-    case PoseStatus::Gap: return "in a dropout";
-    case PoseStatus::TooOld: return "tracker data too old";
+    case PoseStatus::Interpolated:
+      return "interpolated";
+    case PoseStatus::Extrapolated:
+      return "extrapolated";
+    case PoseStatus::NoSamples:
+      return "no samples";
+    case PoseStatus::BeforeFirst:
+      return "before the first sample";
+    case PoseStatus::Gap:
+      return "in a dropout";
+    case PoseStatus::TooOld:
+      return "tracker data too old";
   }
   return "?";
 }

@@ -22,15 +22,24 @@ constexpr int kMaxReadBytes = 4096;
 LibSerial::BaudRate to_libserial_baud(int baud) {
   using B = LibSerial::BaudRate;
   switch (baud) {
-    case 1200: return B::BAUD_1200;
-    case 2400: return B::BAUD_2400;
-    case 4800: return B::BAUD_4800;
-    case 9600: return B::BAUD_9600;
-    case 19200: return B::BAUD_19200;
-    case 38400: return B::BAUD_38400;
-    case 57600: return B::BAUD_57600;
-    case 115200: return B::BAUD_115200;
-    case 230400: return B::BAUD_230400;
+    case 1200:
+      return B::BAUD_1200;
+    case 2400:
+      return B::BAUD_2400;
+    case 4800:
+      return B::BAUD_4800;
+    case 9600:
+      return B::BAUD_9600;
+    case 19200:
+      return B::BAUD_19200;
+    case 38400:
+      return B::BAUD_38400;
+    case 57600:
+      return B::BAUD_57600;
+    case 115200:
+      return B::BAUD_115200;
+    case 230400:
+      return B::BAUD_230400;
   }
   return B::BAUD_INVALID;
 }
@@ -52,8 +61,7 @@ short wait_for(int fd, short events, Nanos timeout, const std::string& path) {
     if (ready >= 0 || errno != EINTR) break;
   }
   if (ready < 0) throw RuntimeError(path + ": poll failed (" + std::strerror(errno) + ")");
-  if (p.revents & (POLLHUP | POLLERR | POLLNVAL))
-    throw DeviceVanished(path + ": the device hung up or was unplugged");
+  if (p.revents & (POLLHUP | POLLERR | POLLNVAL)) throw DeviceVanished(path + ": the device hung up or was unplugged");
   return ready == 0 ? 0 : p.revents;
 }
 
@@ -74,7 +82,7 @@ SerialTransport::SerialTransport(SerialSettings settings) : settings_(std::move(
   if (to_libserial_baud(settings_.baud) == LibSerial::BaudRate::BAUD_INVALID)
     throw InputError(path + ": baud " + std::to_string(settings_.baud) +
                      " is not supported; use one of 9600, 19200, 38400, 57600, 115200");
-  struct stat st{};
+  struct stat st {};
   if (::stat(path.c_str(), &st) != 0)
     throw DeviceVanished(path + ": no such serial port (" + std::strerror(errno) +
                          "); plug the device in or check the path");
@@ -90,8 +98,7 @@ SerialTransport::SerialTransport(SerialSettings settings) : settings_(std::move(
     if (port->fd >= 0) close_port(port);
     if (err == EACCES)
       throw RuntimeError(path + ": permission denied; add your user to the 'dialout' group and log in again");
-    if (err == EBUSY)
-      throw RuntimeError(path + ": in use by another program (exclusive); close it and retry");
+    if (err == EBUSY) throw RuntimeError(path + ": in use by another program (exclusive); close it and retry");
     if (err == ENOTTY) throw RuntimeError(path + ": not a serial port; pick one from `lumar devices`");
     if (err == ENOENT || err == ENXIO || err == ENODEV || err == EIO)
       throw DeviceVanished(path + ": cannot open (" + why + "); the device is not there");

@@ -50,11 +50,16 @@ std::string list_text(const std::vector<int>& list) {
 
 const char* state_name(TrackerState state) {
   switch (state) {
-    case TrackerState::stopped: return "stopped";
-    case TrackerState::connecting: return "connecting";
-    case TrackerState::connected: return "connected";
-    case TrackerState::resetting: return "resetting";
-    case TrackerState::lost: return "lost";
+    case TrackerState::stopped:
+      return "stopped";
+    case TrackerState::connecting:
+      return "connecting";
+    case TrackerState::connected:
+      return "connected";
+    case TrackerState::resetting:
+      return "resetting";
+    case TrackerState::lost:
+      return "lost";
   }
   return "?";
 }
@@ -69,8 +74,8 @@ void validate_driver_settings(const DriverSettings& s) {
                        device_name(s.format.device) + " (1.." + std::to_string(s.format.max_station) + ")");
   if (!s.continuous && !(s.poll_rate_hz > 0 && s.poll_rate_hz <= 1000))
     throw InputError(where + "poll rate " + std::to_string(s.poll_rate_hz) + " Hz must be in (0, 1000]");
-  for (Nanos t : {s.watchdog, s.read_timeout, s.write_timeout, s.quiet_time, s.quiet_limit, s.status_timeout,
-                  s.reopen_interval})
+  for (Nanos t :
+       {s.watchdog, s.read_timeout, s.write_timeout, s.quiet_time, s.quiet_limit, s.status_timeout, s.reopen_interval})
     if (t <= 0) throw InputError(where + "every timeout must be positive");
   if (s.command_gap < 0 || s.reinit_wait < 0 || s.device_latency < 0)
     throw InputError(where + "command gap, reinitialisation wait and latency must not be negative");
@@ -180,8 +185,9 @@ struct TrackerDriver::Impl {
     const std::string& port = transport->name();
     set_state(level == 0 && status.connects == 0 ? TrackerState::connecting : TrackerState::resetting,
               port + ": reset level " + std::to_string(level) +
-                  (level == 0 ? " (c)" : level == 1 ? " (CR + c)" : " (Ctrl-Y, waiting " +
-                                                                      seconds_text(settings.reinit_wait) + ")"));
+                  (level == 0   ? " (c)"
+                   : level == 1 ? " (CR + c)"
+                                : " (Ctrl-Y, waiting " + seconds_text(settings.reinit_wait) + ")"));
     if (level == 1) send("\r");
     if (level == 2) {
       send(std::string(1, kCtrlY));
@@ -236,8 +242,8 @@ struct TrackerDriver::Impl {
       if (!chunk.bytes.empty()) {
         parser.push(chunk);
         for (const TimedIsotrakRecord& r : parser.take_all()) {
-          const auto sample = to_pose_sample(
-              r.record, settings.format.output, measurement_time(r.first_byte_arrival, baud, settings.device_latency));
+          const auto sample = to_pose_sample(r.record, settings.format.output,
+                                             measurement_time(r.first_byte_arrival, baud, settings.device_latency));
           if (!sample) continue;  // decodable but not a pose (e.g. a quaternion far from unit)
           ++valid;
           if (!queue.push(*sample)) ++dropped;
@@ -269,8 +275,8 @@ struct TrackerDriver::Impl {
         // a good status: the next reset needs more force.
         level = receiving ? 0 : (level + 1) % 3;
         update([](DriverStatus& s) { ++s.watchdog_faults; });
-        set_state(TrackerState::resetting, transport->name() + ": no valid record for " +
-                                               seconds_text(settings.watchdog) + "; resetting");
+        set_state(TrackerState::resetting,
+                  transport->name() + ": no valid record for " + seconds_text(settings.watchdog) + "; resetting");
         return;
       }
     }

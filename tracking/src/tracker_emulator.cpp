@@ -147,15 +147,13 @@ struct TrackerEmulator::Impl {
   Nanos send(const std::vector<std::uint8_t>& bytes, Nanos earliest, std::int64_t record = -1) {
     const Nanos begin = std::max(earliest, line_free_at);
     for (std::size_t i = 0; i < bytes.size(); ++i)
-      out.push_back({bytes[i], begin + transmission_time(std::int64_t(i + 1), settings.baud), record,
-                     i + 1 == bytes.size()});
+      out.push_back(
+          {bytes[i], begin + transmission_time(std::int64_t(i + 1), settings.baud), record, i + 1 == bytes.size()});
     line_free_at = begin + transmission_time(std::int64_t(bytes.size()), settings.baud);
     return begin + byte_time;
   }
 
-  void send_text(const std::string& text, Nanos now) {
-    send(std::vector<std::uint8_t>(text.begin(), text.end()), now);
-  }
+  void send_text(const std::string& text, Nanos now) { send(std::vector<std::uint8_t>(text.begin(), text.end()), now); }
 
   Pose true_pose(int station, Nanos t) const { return settings.trajectory(station, t - start); }
 
@@ -255,23 +253,37 @@ struct TrackerEmulator::Impl {
       case 'P':
         if (!state.continuous)
           for (int s = 1; s <= stations; ++s)
-            if (state.active[std::size_t(s - 1)]) produce_record(s, std::max(now, line_free_at - settings.device_latency));
+            if (state.active[std::size_t(s - 1)])
+              produce_record(s, std::max(now, line_free_at - settings.device_latency));
         break;
       case 'C':
         if (!state.continuous) next_measure = now;
         state.continuous = true;
         break;
-      case 'c': state.continuous = false; break;
-      case 'F': state.binary = false; break;
-      case 'f': state.binary = true; break;
-      case 'U': state.centimetres = false; break;
-      case 'u': state.centimetres = true; break;
+      case 'c':
+        state.continuous = false;
+        break;
+      case 'F':
+        state.binary = false;
+        break;
+      case 'f':
+        state.binary = true;
+        break;
+      case 'U':
+        state.centimetres = false;
+        break;
+      case 'u':
+        state.centimetres = true;
+        break;
       case 'S':
         send_text(status_record(), now);
         count([](EmulatorCounters& k) { ++k.status_replies; });
         break;
-      case 'W': power_up(); break;
-      default: return;
+      case 'W':
+        power_up();
+        break;
+      default:
+        return;
     }
     count([](EmulatorCounters& k) { ++k.commands; });
   }
@@ -336,8 +348,8 @@ struct TrackerEmulator::Impl {
         state.boresight.erase(station);
         break;
       }
-      default: break;  // H, R, A, x, v: accepted; no effect on the records
-
+      default:
+        break;  // H, R, A, x, v: accepted; no effect on the records
     }
     count([](EmulatorCounters& k) { ++k.commands; });
   }
@@ -366,10 +378,20 @@ struct TrackerEmulator::Impl {
       return;
     }
     switch (c) {
-      case 'P': case 'C': case 'c': case 'F': case 'f': case 'U': case 'u': case 'S': case 'W':
+      case 'P':
+      case 'C':
+      case 'c':
+      case 'F':
+      case 'f':
+      case 'U':
+      case 'u':
+      case 'S':
+      case 'W':
         execute_letter(c, now);
         return;
-      case '\r': case '\n': case ' ':
+      case '\r':
+      case '\n':
+      case ' ':
         return;
     }
     // Letters of commands that take arguments start a line; other bytes are ignored.
@@ -552,7 +574,8 @@ TrackerEmulator::TrackerEmulator(EmulatorSettings settings, std::function<void(c
   const int stations = station_count(settings.device);
   const std::string where = "emulator: ";
   if (!(settings.rate_hz >= 0 && std::isfinite(settings.rate_hz)))
-    throw InputError(where + "rate " + std::to_string(settings.rate_hz) + " Hz must be positive (or 0 for the device's)");
+    throw InputError(where + "rate " + std::to_string(settings.rate_hz) +
+                     " Hz must be positive (or 0 for the device's)");
   if (settings.baud <= 0) throw InputError(where + "baud " + std::to_string(settings.baud) + " must be positive");
   if (settings.stations.empty()) throw InputError(where + "at least one station must be active");
   for (int s : settings.stations)

@@ -100,7 +100,8 @@ Trajectory load_trajectory_csv(const std::filesystem::path& path) {
     double v[7];
     if (!parse_number(f[0], s.time) || !parse_number(f[1], s.station)) fail("time_ns and station must be integers");
     for (int i = 0; i < 7; ++i)
-      if (!parse_number(f[2 + i], v[i]) || !std::isfinite(v[i])) fail("field " + std::to_string(3 + i) + " is not a number");
+      if (!parse_number(f[2 + i], v[i]) || !std::isfinite(v[i]))
+        fail("field " + std::to_string(3 + i) + " is not a number");
     if (s.station < 1 || s.station > 9) fail("station " + std::to_string(s.station) + " is outside 1..9");
     const glm::dquat q(v[3], v[4], v[5], v[6]);
     const double norm = glm::length(q);

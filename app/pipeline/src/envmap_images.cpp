@@ -1,18 +1,18 @@
 #include "lumar/pipeline/envmap_images.h"
 
+#include <spdlog/spdlog.h>
 #include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <map>
 #include <opencv2/imgcodecs.hpp>
-#include <spdlog/spdlog.h>
 #include <sstream>
 
+#include "lumar/base/error.h"
 #include "lumar/calib/camera_file.h"
 #include "lumar/calib/camera_response.h"
 #include "lumar/capture/image_sequence_source.h"
-#include "lumar/base/error.h"
 
 namespace lumar::app {
 
@@ -52,7 +52,8 @@ std::vector<PoseRow> read_poses_csv(const std::string& path) {
   std::ifstream in(path);
   if (!in) throw InputError(path + ": cannot read the poses; check the path");
   std::string line;
-  if (!std::getline(in, line)) throw InputError(path + ": empty; expected a header file,qw,qx,qy,qz[,x,y,z][,exposure][,station]");
+  if (!std::getline(in, line))
+    throw InputError(path + ": empty; expected a header file,qw,qx,qy,qz[,x,y,z][,exposure][,station]");
   if (!line.empty() && line.back() == '\r') line.pop_back();
   const std::vector<std::string> header = split_fields(line);
   std::map<std::string, int> column;
@@ -79,7 +80,8 @@ std::vector<PoseRow> read_poses_csv(const std::string& path) {
     const std::string where = path + ":" + std::to_string(line_number) + ": ";
     const auto f = split_fields(line);
     if (f.size() != header.size())
-      throw InputError(where + "expected " + std::to_string(header.size()) + " fields, found " + std::to_string(f.size()));
+      throw InputError(where + "expected " + std::to_string(header.size()) + " fields, found " +
+                       std::to_string(f.size()));
     auto number = [&](const char* name) {
       double v = 0;
       if (!parse_double(f[column.at(name)], v) || !std::isfinite(v))
@@ -101,13 +103,15 @@ std::vector<PoseRow> read_poses_csv(const std::string& path) {
     if (positions == 3) r.position = glm::dvec3(number("x"), number("y"), number("z"));
     if (column.count("exposure")) {
       r.exposure = number("exposure");
-      if (!(r.exposure > 0)) throw InputError(where + "exposure must be positive (video linear value per unit radiance)");
+      if (!(r.exposure > 0))
+        throw InputError(where + "exposure must be positive (video linear value per unit radiance)");
     }
     if (column.count("station")) {
       const std::string& s = f[column.at("station")];
       int v = 0;
       const auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
-      if (ec != std::errc() || end != s.data() + s.size()) throw InputError(where + "station '" + s + "' is not an integer");
+      if (ec != std::errc() || end != s.data() + s.size())
+        throw InputError(where + "station '" + s + "' is not an integer");
       r.station = v;
     }
     rows.push_back(r);
@@ -122,7 +126,8 @@ std::string key_of(const fs::path& p) { return p.lexically_normal().string(); }
 
 SweepInput images_sweep_input(const ImagesInputOptions& o, int width) {
   if (o.poses.empty()) throw InputError("--images needs --poses POSES.csv (file,qw,qx,qy,qz per image)");
-  if (o.camera.empty()) throw InputError("--images needs --camera CAM.yml, the calibration of the camera that took them");
+  if (o.camera.empty())
+    throw InputError("--images needs --camera CAM.yml, the calibration of the camera that took them");
   const std::vector<PoseRow> rows = read_poses_csv(o.poses);
   const CameraIntrinsics camera = calib::load_camera_file(o.camera).intrinsics;
 
@@ -149,14 +154,17 @@ SweepInput images_sweep_input(const ImagesInputOptions& o, int width) {
     const std::string where = o.poses + ":" + std::to_string(rows[r].line) + ": ";
     const auto it = image_index.find(key_of(p));
     if (it == image_index.end()) {
-      if (!fs::exists(p, ec)) throw InputError(where + "the image " + p.string() + " does not exist; add it or drop the row");
-      throw InputError(where + p.string() + " is not one of the images of " + o.images + "; drop the row or widen the glob");
+      if (!fs::exists(p, ec))
+        throw InputError(where + "the image " + p.string() + " does not exist; add it or drop the row");
+      throw InputError(where + p.string() + " is not one of the images of " + o.images +
+                       "; drop the row or widen the glob");
     }
     row_of[it->second] = r;
   }
   for (int i = 0; i < int(files.size()); ++i)
     if (row_of[i] < 0)
-      throw InputError(o.poses + ": no pose for " + files[i].string() + "; add a row for it or move it out of " + o.images);
+      throw InputError(o.poses + ": no pose for " + files[i].string() + "; add a row for it or move it out of " +
+                       o.images);
 
   SweepInput in;
   in.name = o.images;
@@ -230,9 +238,10 @@ void export_sweep_images(const SweepInput& in, const std::string& dir_text) {
     throw;
   }
   fs::rename(tmp, dir);
-  spdlog::info("envmap: stitch them with: lumar envmap --images {0} --poses {0}/poses.csv --camera {0}/camera.yml "
-               "--vignetting {1} --vignetting-b {2} --out OUT.exr (and the recording's camera response, if not sRGB)",
-               dir_text, in.stitch.vignetting_a, in.stitch.vignetting_b);
+  spdlog::info(
+      "envmap: stitch them with: lumar envmap --images {0} --poses {0}/poses.csv --camera {0}/camera.yml "
+      "--vignetting {1} --vignetting-b {2} --out OUT.exr (and the recording's camera response, if not sRGB)",
+      dir_text, in.stitch.vignetting_a, in.stitch.vignetting_b);
 }
 
 }  // namespace lumar::app

@@ -7,11 +7,11 @@
 #include <optional>
 #include <thread>
 
+#include "lumar/base/error.h"
 #include "lumar/calib/camera_response.h"
 #include "lumar/capture/capture_thread.h"
 #include "lumar/capture/frame_pose_pairing.h"
 #include "lumar/capture/recording_replay.h"
-#include "lumar/base/error.h"
 #include "lumar/pipeline/stop_signal.h"
 
 namespace lumar::app {
@@ -103,13 +103,16 @@ void run_live_envmap(const LiveEnvmapOptions& o) {
     st.vignetting_a = session.radiometry.vignetting_a;
     st.vignetting_b = session.radiometry.vignetting_b;
     exposures = {session.radiometry.exposure};
-    if (session.extra.contains("frame_exposures")) exposures = session.extra["frame_exposures"].get<std::vector<double>>();
+    if (session.extra.contains("frame_exposures"))
+      exposures = session.extra["frame_exposures"].get<std::vector<double>>();
     for (double e : exposures)
       if (!(e > 0) || !std::isfinite(e)) throw InputError(o.in.source + ": session exposures must be positive numbers");
-    if (session.extra.contains("envmap")) st.azimuth_offset_deg = session.extra["envmap"].value("azimuth_offset_deg", 0.0);
+    if (session.extra.contains("envmap"))
+      st.azimuth_offset_deg = session.extra["envmap"].value("azimuth_offset_deg", 0.0);
     for (const auto& f : replay->reader().frames()) recorded_time[f.index] = f.time;
     bracket = session.extra.value("exposure_bracket", false);
-    if (session.extra.contains("synth")) kept.tracker_noise_deg = session.extra["synth"].value("tracker_noise_deg", 0.75);
+    if (session.extra.contains("synth"))
+      kept.tracker_noise_deg = session.extra["synth"].value("tracker_noise_deg", 0.75);
     if (session.extra.contains("envmap")) {
       const std::string source_map = session.extra["envmap"].value("source_map", std::string());
       if (std::error_code ec; reference.empty() && !source_map.empty() && std::filesystem::exists(source_map, ec))
@@ -136,8 +139,8 @@ void run_live_envmap(const LiveEnvmapOptions& o) {
       if (monotonic_now() >= give_up) {
         const std::string why = driver->status().message;
         driver->stop();
-        throw InputError(o.in.tracker + ": no pose from the tracker within " + std::to_string(int(o.tracker_timeout_s)) +
-                         " s (" + (why.empty() ? "no answer" : why) +
+        throw InputError(o.in.tracker + ": no pose from the tracker within " +
+                         std::to_string(int(o.tracker_timeout_s)) + " s (" + (why.empty() ? "no answer" : why) +
                          "); check that it is on, the port, --tracker-device and --baud");
       }
       samples.clear();
@@ -221,7 +224,8 @@ void run_live_envmap(const LiveEnvmapOptions& o) {
       const Nanos t = frame.time;
       const capture::PairedFrame paired = pairing.pair(std::move(frame));
       // An extrapolated pose is a guess; a map keeps what it was given, so skip it.
-      if (paired.T_world_camera && paired.sensor.status != tracking::PoseStatus::Extrapolated) pose = paired.T_world_camera;
+      if (paired.T_world_camera && paired.sensor.status != tracking::PoseStatus::Extrapolated)
+        pose = paired.T_world_camera;
       if (frames % 300 == 0) pairing.forget_before(t - kNanosPerSecond);
       frame = paired.frame;
     }
@@ -253,8 +257,8 @@ void run_live_envmap(const LiveEnvmapOptions& o) {
   capture.stop();
   if (driver) driver->stop();
   write_now();
-  spdlog::info("envmap: {} frames, {} stitched, {} without a pose, {} updates of {}", frames,
-               stitcher.frames_added(), without_pose, updates, o.out.out);
+  spdlog::info("envmap: {} frames, {} stitched, {} without a pose, {} updates of {}", frames, stitcher.frames_added(),
+               without_pose, updates, o.out.out);
   if (stitcher.frames_added() > 0) compare_with_reference(stitcher.current_map(), stitcher.coverage(), reference);
   if (o.refine_at_end && kept_all && !kept_frames.empty()) {
     spdlog::info("envmap: the sweep is over; refining its {} frames and stitching them again", kept_frames.size());

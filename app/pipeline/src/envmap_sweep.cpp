@@ -2,18 +2,18 @@
 
 #include <unistd.h>
 
+#include <spdlog/spdlog.h>
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
-#include <spdlog/spdlog.h>
 
+#include "lumar/base/error.h"
+#include "lumar/base/pose.h"
 #include "lumar/envmap/envmap_quality.h"
 #include "lumar/envmap/hole_filling.h"
 #include "lumar/envmap/orientation_refinement.h"
-#include "lumar/base/error.h"
-#include "lumar/base/pose.h"
 
 namespace lumar::app {
 
@@ -110,10 +110,11 @@ void stitch_sweep(const SweepInput& in, const EnvmapOutputOptions& o) {
     rotations = result.rotations;
     double mean = 0, worst = 0;
     for (double c : result.correction_deg) mean += c / n, worst = std::max(worst, c);
-    spdlog::info("envmap: refined {} frames from {} pairs ({} matches, {} frames unmatched): corrections mean {:.3f} "
-                 "deg, max {:.3f} deg; match residual {:.3f} -> {:.3f} deg RMS",
-                 n, result.pairs, result.matches, result.unmatched_frames, mean, worst, result.residual_before_deg,
-                 result.residual_after_deg);
+    spdlog::info(
+        "envmap: refined {} frames from {} pairs ({} matches, {} frames unmatched): corrections mean {:.3f} "
+        "deg, max {:.3f} deg; match residual {:.3f} -> {:.3f} deg RMS",
+        n, result.pairs, result.matches, result.unmatched_frames, mean, worst, result.residual_before_deg,
+        result.residual_after_deg);
     if (!o.corrections.empty()) write_corrections(in, result, o.corrections);
   }
   // With ground truth (synthetic sweeps), say how close the rotations came.

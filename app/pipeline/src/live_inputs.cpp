@@ -3,11 +3,11 @@
 #include <filesystem>
 #include <fstream>
 
+#include "lumar/base/error.h"
 #include "lumar/calib/camera_file.h"
 #include "lumar/capture/capture_thread.h"
 #include "lumar/capture/session.h"
 #include "lumar/capture/source_spec.h"
-#include "lumar/base/error.h"
 #include "lumar/tracking/serial_transport.h"
 
 namespace lumar::app {
@@ -117,7 +117,8 @@ nlohmann::json live_session(const LiveInputOptions& o, const CameraIntrinsics& c
   }
   nlohmann::json j = capture::session_to_json(s);
   j["source"] = "lumar record";
-  j["capture"] = {{"source", o.source}, {"tracker", o.tracker.empty() ? "none" : o.tracker},
+  j["capture"] = {{"source", o.source},
+                  {"tracker", o.tracker.empty() ? "none" : o.tracker},
                   {"camera_calibrated", !o.camera_file.empty()}};
   if (!driver) j.erase("tracker");
   return j;

@@ -21,8 +21,12 @@ calib::LightingAdapterSettings adapter_settings(const calib::CameraResponse& res
 LiveLighting::LiveLighting(const CameraIntrinsics& video_camera, const calib::UndistortionMaps& maps,
                            const calib::CameraResponse& response, const capture::Radiometry& radiometry,
                            int every_n_frames)
-    : map_x_(maps.map_x), map_y_(maps.map_y), response_(response), exposure_(radiometry.exposure),
-      every_(std::max(1, every_n_frames)), adapter_(adapter_settings(response, radiometry.exposure)) {
+    : map_x_(maps.map_x),
+      map_y_(maps.map_y),
+      response_(response),
+      exposure_(radiometry.exposure),
+      every_(std::max(1, every_n_frames)),
+      adapter_(adapter_settings(response, radiometry.exposure)) {
   small_camera_ = maps.output.without_distortion();
   small_camera_.width = maps.output.width / kShrink;
   small_camera_.height = maps.output.height / kShrink;
@@ -32,13 +36,12 @@ LiveLighting::LiveLighting(const CameraIntrinsics& video_camera, const calib::Un
   small_camera_.cx = (maps.output.cx + 0.5) / kShrink - 0.5;
   small_camera_.cy = (maps.output.cy + 0.5) / kShrink - 0.5;
   const cv::Size video_size(video_camera.width, video_camera.height);
-  cv::Mat gain = calib::vignetting_gain(video_size, radiometry.vignetting_a, radiometry.vignetting_b,
-                                        video_camera.cx, video_camera.cy);
+  cv::Mat gain = calib::vignetting_gain(video_size, radiometry.vignetting_a, radiometry.vignetting_b, video_camera.cx,
+                                        video_camera.cy);
   cv::divide(1.0, gain, inverse_gain_);
 }
 
-double LiveLighting::update(gl::Renderer& renderer, const cv::Mat& video_bgr8, const Pose& T_world_camera,
-                            Nanos time) {
+double LiveLighting::update(gl::Renderer& renderer, const cv::Mat& video_bgr8, const Pose& T_world_camera, Nanos time) {
   if (calls_++ % every_ != 0) return scale();
   // Observed radiance: linearise, undo vignetting and exposure, undistort, shrink.
   cv::Mat linear = calib::linearize(video_bgr8, response_);

@@ -4,14 +4,14 @@
 
 #include <thread>
 
+#include "lumar/base/error.h"
 #include "lumar/calib/undistortion.h"
 #include "lumar/capture/capture_thread.h"
 #include "lumar/capture/frame_pose_pairing.h"
+#include "lumar/pipeline/stop_signal.h"
 #include "lumar/render/compositor.h"
-#include "lumar/base/error.h"
 #include "lumar/render/platform/context.h"
 #include "lumar/scene/scene.h"
-#include "lumar/pipeline/stop_signal.h"
 
 namespace lumar::app {
 

@@ -75,15 +75,16 @@ void FramesOutput::commit() {
   committed_ = true;
 }
 
-void write_contact_sheet(const fs::path& png, const std::vector<std::pair<std::int64_t, cv::Mat>>& frames,
-                         int columns, int tile_width) {
+void write_contact_sheet(const fs::path& png, const std::vector<std::pair<std::int64_t, cv::Mat>>& frames, int columns,
+                         int tile_width) {
   if (frames.empty()) return;
   const cv::Size first = frames.front().second.size();
   const cv::Size tile(tile_width, tile_width * first.height / first.width);
   const int rows = (int(frames.size()) + columns - 1) / columns;
   cv::Mat sheet(rows * tile.height, std::min<int>(columns, frames.size()) * tile.width, CV_8UC3, cv::Scalar::all(0));
   for (std::size_t i = 0; i < frames.size(); ++i) {
-    cv::Mat cell = sheet(cv::Rect(int(i % columns) * tile.width, int(i / columns) * tile.height, tile.width, tile.height));
+    cv::Mat cell =
+        sheet(cv::Rect(int(i % columns) * tile.width, int(i / columns) * tile.height, tile.width, tile.height));
     cv::resize(frames[i].second, cell, tile, 0, 0, cv::INTER_AREA);
     const std::string label = fmt::format("frame {}", frames[i].first);
     cv::putText(cell, label, {7, 19}, cv::FONT_HERSHEY_SIMPLEX, 0.5, cv::Scalar::all(0), 2, cv::LINE_AA);

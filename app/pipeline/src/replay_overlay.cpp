@@ -1,11 +1,11 @@
 #include "lumar/pipeline/replay_overlay.h"
 
-#include <chrono>
 #include <fmt/format.h>
+#include <chrono>
 
+#include "lumar/base/error.h"
 #include "lumar/calib/camera_response.h"
 #include "lumar/calib/undistortion.h"
-#include "lumar/base/error.h"
 
 namespace lumar::app {
 
@@ -37,8 +37,7 @@ ReplayOverlay::ReplayOverlay(const std::filesystem::path& recording, const std::
                              int adapt_lighting_every)
     : replay_(recording), pose_source_(poses) {
   const std::filesystem::path scene_path = scene_override.empty() ? replay_.scene_path() : scene_override;
-  if (scene_path.empty())
-    throw InputError((recording / "session.json").string() + ": names no scene; pass --scene");
+  if (scene_path.empty()) throw InputError((recording / "session.json").string() + ": names no scene; pass --scene");
   scene_ = load_scene(scene_path);
   if (poses == PoseSource::Truth && replay_.reader().truth().empty())
     throw InputError(recording.string() + ": has no ground truth (truth.csv); use the tracker's poses");
@@ -111,11 +110,15 @@ void ReplayOverlay::run(int max_frames, const std::function<bool(const OverlayFr
 
 std::string format_stage_times(const StageTimes& t) {
   const int n = std::max(1, t.frames);
-  const std::pair<const char*, double> stages[] = {
-      {"decode video", t.decode},      {"tracker pose", t.pose},   {"lighting adaptation", t.lighting},
-      {"upload frame", t.upload},
-      {"background (undistort)", t.background}, {"proxy depth", t.depth}, {"virtual objects", t.objects},
-      {"read back", t.readback},       {"encode output", t.output}};
+  const std::pair<const char*, double> stages[] = {{"decode video", t.decode},
+                                                   {"tracker pose", t.pose},
+                                                   {"lighting adaptation", t.lighting},
+                                                   {"upload frame", t.upload},
+                                                   {"background (undistort)", t.background},
+                                                   {"proxy depth", t.depth},
+                                                   {"virtual objects", t.objects},
+                                                   {"read back", t.readback},
+                                                   {"encode output", t.output}};
   double total = 0;
   for (const auto& s : stages) total += s.second;
   std::string text = fmt::format("{:<24}{:>10}{:>8}\n", "stage", "ms/frame", "share");

@@ -49,8 +49,8 @@ cv::Mat EnvmapViewRenderer::render(const EnvironmentMap& map, const glm::dquat& 
   return out;
 }
 
-cv::Mat expose_8bit(const cv::Mat& radiance_bgr, const CameraIntrinsics& camera, const SensorModel& s,
-                    double exposure, cv::RNG& rng) {
+cv::Mat expose_8bit(const cv::Mat& radiance_bgr, const CameraIntrinsics& camera, const SensorModel& s, double exposure,
+                    cv::RNG& rng) {
   const double half_diagonal = 0.5 * std::hypot(camera.width, camera.height);
   cv::Mat out(radiance_bgr.size(), CV_8UC3);
   for (int y = 0; y < out.rows; ++y) {

@@ -1,17 +1,17 @@
 #include "lumar/sim/synthetic_board.h"
 
+#include <spdlog/spdlog.h>
 #include <cmath>
 #include <mutex>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
-#include <spdlog/spdlog.h>
 
+#include "lumar/base/error.h"
 #include "lumar/capture/recording_writer.h"
 #include "lumar/capture/session.h"
-#include "lumar/base/error.h"
+#include "lumar/sim/synthetic_recording.h"
 #include "lumar/tracking/rig.h"
 #include "lumar/tracking/simulated_tracker.h"
-#include "lumar/sim/synthetic_recording.h"
 
 namespace lumar::app {
 
@@ -114,7 +114,7 @@ cv::Mat render_board_image(const CameraIntrinsics& camera, cv::Size board, doubl
   const cv::Matx33d Hinv = H.inv();
   const double s = square;
   const double cx0 = -s, cx1 = board.width * s, cy0 = -s, cy1 = board.height * s;  // the squares
-  const double bx0 = cx0 - s, bx1 = cx1 + s, by0 = cy0 - s, by1 = cy1 + s;          // white margin, one square
+  const double bx0 = cx0 - s, bx1 = cx1 + s, by0 = cy0 - s, by1 = cy1 + s;         // white margin, one square
   const double far = 1e3;  // rays that miss the plane (behind the camera) land here, off the board
 
   std::vector<cv::Point2d> plane(rays.xy.size());
@@ -177,20 +177,19 @@ void synthesize_board_recording(const BoardSynthSettings& s) {
   session.camera = s.camera;
   session.rig.latency = seconds_to_nanos(s.assumed_latency_ms * 1e-3);
   session.extra["source"] = "lumar synth --board";
-  session.extra["synth_board"] = {
-      {"board", std::to_string(s.board.width) + "x" + std::to_string(s.board.height)},
-      {"square", s.square},
-      {"seconds", s.seconds},
-      {"fps", s.fps},
-      {"tracker_noise_deg", s.tracker_noise_deg},
-      {"position_noise_m", s.position_noise_m},
-      {"image_noise", s.image_noise},
-      {"seed", s.seed},
-      {"truth",
-       {{"T_world_transmitter", tracking::pose_to_json(truth.T_world_transmitter)},
-        {"T_sensor_camera", tracking::pose_to_json(truth.T_sensor_camera)},
-        {"T_world_board", tracking::pose_to_json(T_world_board)},
-        {"latency_ns", truth.latency}}}};
+  session.extra["synth_board"] = {{"board", std::to_string(s.board.width) + "x" + std::to_string(s.board.height)},
+                                  {"square", s.square},
+                                  {"seconds", s.seconds},
+                                  {"fps", s.fps},
+                                  {"tracker_noise_deg", s.tracker_noise_deg},
+                                  {"position_noise_m", s.position_noise_m},
+                                  {"image_noise", s.image_noise},
+                                  {"seed", s.seed},
+                                  {"truth",
+                                   {{"T_world_transmitter", tracking::pose_to_json(truth.T_world_transmitter)},
+                                    {"T_sensor_camera", tracking::pose_to_json(truth.T_sensor_camera)},
+                                    {"T_world_board", tracking::pose_to_json(T_world_board)},
+                                    {"latency_ns", truth.latency}}}};
 
   // Half a second of tracker on either side of the video, so that a wrong assumed
   // latency still leaves tracker poses around every frame.
@@ -200,15 +199,18 @@ void synthesize_board_recording(const BoardSynthSettings& s) {
   const Nanos duration = start + frame_period * frames + seconds_to_nanos(0.5);
   auto true_camera = [&](Nanos t) { return board_synth_camera_pose(nanos_to_seconds(t), s.board, s.square); };
 
-  const auto tracker = simulate_session_tracker(session, truth.latency, s.tracker_noise_deg, s.position_noise_m, s.seed,
-                                                [&](Nanos t) { return truth.sensor_pose(true_camera(t)); }, duration);
+  const auto tracker = simulate_session_tracker(
+      session, truth.latency, s.tracker_noise_deg, s.position_noise_m, s.seed,
+      [&](Nanos t) { return truth.sensor_pose(true_camera(t)); }, duration);
 
-  const capture::RecordingSettings video{.codec = s.codec, .fps = s.fps, .size = cv::Size(s.camera.width, s.camera.height)};
+  const capture::RecordingSettings video{
+      .codec = s.codec, .fps = s.fps, .size = cv::Size(s.camera.width, s.camera.height)};
   cv::Mat noise(video.size, CV_32F), grey, bgr;
   write_synthetic_recording(
       s.out, session, tracker, video, frames, s.seed, [&](int k) { return start + frame_period * k; }, true_camera,
       [&](int, Nanos, const Pose& T_world_camera, cv::RNG& rng) {
-        render_board_image(s.camera, s.board, s.square, T_world_camera.inverse() * T_world_board).convertTo(grey, CV_32F);
+        render_board_image(s.camera, s.board, s.square, T_world_camera.inverse() * T_world_board)
+            .convertTo(grey, CV_32F);
         rng.fill(noise, cv::RNG::NORMAL, 0.0, s.image_noise);
         cv::Mat(grey + noise).convertTo(grey, CV_8U);  // rounds and clips
         cv::cvtColor(grey, bgr, cv::COLOR_GRAY2BGR);

@@ -1,21 +1,21 @@
 #include "lumar/sim/synthetic_recording.h"
 
+#include <spdlog/spdlog.h>
 #include <cmath>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
-#include <spdlog/spdlog.h>
 
-#include "lumar/sim/envmap_view.h"
+#include "lumar/base/color.h"
+#include "lumar/base/error.h"
 #include "lumar/calib/undistortion.h"
 #include "lumar/capture/recording_writer.h"
 #include "lumar/capture/session.h"
-#include "lumar/base/color.h"
-#include "lumar/scene/envmap.h"
-#include "lumar/base/error.h"
 #include "lumar/render/platform/context.h"
 #include "lumar/render/renderer.h"
+#include "lumar/scene/envmap.h"
 #include "lumar/scene/mesh.h"
 #include "lumar/scene/scene.h"
+#include "lumar/sim/envmap_view.h"
 #include "lumar/tracking/isotrak_ascii.h"
 #include "lumar/tracking/pose_conversion.h"
 #include "lumar/tracking/simulated_tracker.h"
@@ -120,8 +120,8 @@ CameraIntrinsics covering_pinhole(const CameraIntrinsics& camera, int supersampl
 }
 
 // Radiance (linear, scene units) to an 8-bit frame as the camera would record it.
-cv::Mat expose(const cv::Mat& radiance_bgr, const CameraIntrinsics& camera, const SynthSettings& s,
-               double exposure, cv::RNG& rng) {
+cv::Mat expose(const cv::Mat& radiance_bgr, const CameraIntrinsics& camera, const SynthSettings& s, double exposure,
+               cv::RNG& rng) {
   calib::SensorModel sensor;
   sensor.read_noise = s.read_noise;
   sensor.shot_noise_gain = s.shot_noise_gain;
@@ -148,8 +148,8 @@ Pose orbit_camera_pose(const glm::dvec3& target, double s, double arc_deg) {
   const double az = glm::radians(start_deg + arc_deg * s);
   const double radius = 1.55;
   const double height = 1.25 - 0.15 * s + 0.03 * std::sin(6.0 * s);
-  const glm::dvec3 eye = target + glm::dvec3(radius * std::sin(az), 0.0, radius * std::cos(az)) +
-                         glm::dvec3(0, height - target.y, 0);
+  const glm::dvec3 eye =
+      target + glm::dvec3(radius * std::sin(az), 0.0, radius * std::cos(az)) + glm::dvec3(0, height - target.y, 0);
   return look_at(eye, target + glm::dvec3(0, 0.08, 0));
 }
 
@@ -181,11 +181,14 @@ void synthesize_recording(const SynthSettings& s) {
   session.scene =
       std::filesystem::relative(std::filesystem::absolute(s.scene), std::filesystem::absolute(s.out)).string();
   session.extra["source"] = "lumar synth";
-  session.extra["synth"] = {{"frames", s.frames},          {"fps", s.fps},
+  session.extra["synth"] = {{"frames", s.frames},
+                            {"fps", s.fps},
                             {"tracker_noise_deg", s.tracker_noise_deg},
                             {"position_noise_m", s.position_noise_m},
-                            {"read_noise", s.read_noise},  {"shot_noise_gain", s.shot_noise_gain},
-                            {"arc_deg", s.arc_deg},        {"seed", s.seed}};
+                            {"read_noise", s.read_noise},
+                            {"shot_noise_gain", s.shot_noise_gain},
+                            {"arc_deg", s.arc_deg},
+                            {"seed", s.seed}};
 
   const glm::dvec3 target = scene_target(scene);
   const Nanos start = seconds_to_nanos(0.1);  // tracker runs before the first frame
@@ -197,9 +200,9 @@ void synthesize_recording(const SynthSettings& s) {
     return orbit_camera_pose(target, u, s.arc_deg);
   };
 
-  const auto tracker = simulate_session_tracker(session, session.rig.latency, s.tracker_noise_deg, s.position_noise_m,
-                                                s.seed, [&](Nanos t) { return session.rig.sensor_pose(true_camera(t)); },
-                                                duration);
+  const auto tracker = simulate_session_tracker(
+      session, session.rig.latency, s.tracker_noise_deg, s.position_noise_m, s.seed,
+      [&](Nanos t) { return session.rig.sensor_pose(true_camera(t)); }, duration);
 
   // Exposure: the first view's mean radiance becomes 18 % grey unless given.
   double exposure = s.exposure;
@@ -222,8 +225,8 @@ void synthesize_recording(const SynthSettings& s) {
         const cv::Mat radiance = renderer.render_room_radiance(pinhole, T_world_camera);
         return expose(calib::distort_image(radiance, pinhole, s.camera), s.camera, s, exposure, rng);
       });
-  spdlog::info("synth: wrote {} ({} frames, exposure {:.4g}, tracker {} records)", s.out.string(), s.frames,
-               exposure, tracker.noisy_samples.size());
+  spdlog::info("synth: wrote {} ({} frames, exposure {:.4g}, tracker {} records)", s.out.string(), s.frames, exposure,
+               tracker.noisy_samples.size());
 }
 
 }  // namespace lumar::app

@@ -1,17 +1,17 @@
 #include "lumar/sim/synthetic_sweep.h"
 
+#include <spdlog/spdlog.h>
 #include <cmath>
 #include <memory>
 #include <sstream>
-#include <spdlog/spdlog.h>
 
+#include "lumar/base/error.h"
 #include "lumar/calib/camera_file.h"
-#include "lumar/sim/envmap_view.h"
-#include "lumar/envmap/sweep_path.h"
 #include "lumar/capture/recording_writer.h"
 #include "lumar/capture/session.h"
+#include "lumar/envmap/sweep_path.h"
 #include "lumar/scene/envmap.h"
-#include "lumar/base/error.h"
+#include "lumar/sim/envmap_view.h"
 #include "lumar/tracking/simulated_tracker.h"
 
 namespace lumar::app {
@@ -97,9 +97,7 @@ void synthesize_sweep(const SynthSettings& s, const SweepSynthSettings& sw) {
   timing.station_length = (timing.per_station - 1) * timing.period + timing.move + 2 * timing.margin;
   timing.start = seconds_to_nanos(0.1);  // the tracker runs before the first frame
   const Nanos duration = timing.frame_time(s.frames - 1) + seconds_to_nanos(0.2);
-  auto true_camera = [&](Nanos t) {
-    return Pose{calib::sweep_rotation(timing.path_s(t)), sw.capture_position};
-  };
+  auto true_camera = [&](Nanos t) { return Pose{calib::sweep_rotation(timing.path_s(t)), sw.capture_position}; };
 
   capture::Session session;
   session.camera = s.camera;
@@ -113,9 +111,10 @@ void synthesize_sweep(const SynthSettings& s, const SweepSynthSettings& sw) {
   session.extra["frame_exposures"] = exposures;
   // Frames k = m n .. m n + n - 1 were taken standing still (one rotation).
   session.extra["exposure_bracket"] = timing.bracket;
-  session.extra["envmap"] = {{"capture_position", {sw.capture_position.x, sw.capture_position.y, sw.capture_position.z}},
-                             {"azimuth_offset_deg", map.azimuth_offset_deg},
-                             {"source_map", std::filesystem::absolute(sw.envmap).string()}};
+  session.extra["envmap"] = {
+      {"capture_position", {sw.capture_position.x, sw.capture_position.y, sw.capture_position.z}},
+      {"azimuth_offset_deg", map.azimuth_offset_deg},
+      {"source_map", std::filesystem::absolute(sw.envmap).string()}};
   session.extra["synth"] = {{"frames", s.frames},
                             {"fps", s.fps},
                             {"exposure_mode", sw.exposure_mode},
@@ -126,9 +125,9 @@ void synthesize_sweep(const SynthSettings& s, const SweepSynthSettings& sw) {
                             {"shot_noise_gain", s.shot_noise_gain},
                             {"seed", s.seed}};
 
-  const auto tracker = simulate_session_tracker(session, session.rig.latency, s.tracker_noise_deg, s.position_noise_m,
-                                                s.seed, [&](Nanos t) { return session.rig.sensor_pose(true_camera(t)); },
-                                                duration);
+  const auto tracker = simulate_session_tracker(
+      session, session.rig.latency, s.tracker_noise_deg, s.position_noise_m, s.seed,
+      [&](Nanos t) { return session.rig.sensor_pose(true_camera(t)); }, duration);
 
   calib::SensorModel sensor;
   sensor.read_noise = s.read_noise;

@@ -115,7 +115,8 @@ void EnvmapStitcher::prepare_levels(const cv::Mat& image, double exposure) {
         std::uint8_t clip = 0;
         for (int dy = 0; dy < 2; ++dy)
           for (int dx = 0; dx < 2; ++dx) {
-            const std::size_t i = std::size_t(std::min(2 * y + dy, f.height - 1)) * f.width + std::min(2 * x + dx, f.width - 1);
+            const std::size_t i =
+                std::size_t(std::min(2 * y + dy, f.height - 1)) * f.width + std::min(2 * x + dx, f.width - 1);
             sum[0] += f.rgb[i * 3], sum[1] += f.rgb[i * 3 + 1], sum[2] += f.rgb[i * 3 + 2];
             w += f.weight[i];
             clip |= f.clipped[i];
@@ -224,8 +225,8 @@ void EnvmapStitcher::add_frame(const cv::Mat& image, const glm::dquat& R_world_c
         const std::uint8_t kind = clipped ? 2 : 1;
         float* f = &fallback_[idx * 3];
         const float lum = rgb[0] + rgb[1] + rgb[2], old = f[0] + f[1] + f[2];
-        const bool take = kind > fallback_kind_[idx] ||
-                          (kind == fallback_kind_[idx] && (clipped ? lum > old : lum < old));
+        const bool take =
+            kind > fallback_kind_[idx] || (kind == fallback_kind_[idx] && (clipped ? lum > old : lum < old));
         if (take) {
           f[0] = rgb[0], f[1] = rgb[1], f[2] = rgb[2];
           fallback_kind_[idx] = kind;

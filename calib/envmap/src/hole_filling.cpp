@@ -139,7 +139,8 @@ cv::Mat contact_sheet(const EnvironmentMap& map, const cv::Mat& count) {
         cv::Vec3b px(uchar(std::lround(linear_to_srgb(t.b) * 255)), uchar(std::lround(linear_to_srgb(t.g) * 255)),
                      uchar(std::lround(linear_to_srgb(t.r) * 255)));
         // Hatch filled holes so nobody mistakes them for measured light.
-        if (!count.empty() && count.at<std::uint16_t>(r, c) == 0 && ((r + c) / 4) % 2 == 0) px = px / 2 + cv::Vec3b(0, 0, 96);
+        if (!count.empty() && count.at<std::uint16_t>(r, c) == 0 && ((r + c) / 4) % 2 == 0)
+          px = px / 2 + cv::Vec3b(0, 0, 96);
         sheet.at<cv::Vec3b>(s * map.height + r, c) = px;
       }
   }
@@ -147,8 +148,8 @@ cv::Mat contact_sheet(const EnvironmentMap& map, const cv::Mat& count) {
 }
 
 void write_image_atomically(const std::filesystem::path& path, const cv::Mat& image) {
-  const std::filesystem::path tmp = path.parent_path() / ("." + path.filename().string() + ".partial" +
-                                                          path.extension().string());
+  const std::filesystem::path tmp =
+      path.parent_path() / ("." + path.filename().string() + ".partial" + path.extension().string());
   bool ok = false;
   try {
     ok = cv::imwrite(tmp.string(), image);

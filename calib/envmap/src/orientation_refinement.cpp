@@ -113,7 +113,8 @@ std::vector<Match> match_pair(int i, int j, const FrameFeatures& fi, const Frame
   if (int(a.size()) < s.min_matches) return out;
   // Fit the pair's relative rotation, keep what agrees with it, and fit again.
   glm::dmat3 R = fit_rotation(a, b);
-  const double thresholds[2] = {std::max(glm::radians(1.0), 3 * glm::radians(s.inlier_deg)), glm::radians(s.inlier_deg)};
+  const double thresholds[2] = {std::max(glm::radians(1.0), 3 * glm::radians(s.inlier_deg)),
+                                glm::radians(s.inlier_deg)};
   for (double t : thresholds) {
     std::vector<glm::dvec3> a2, b2;
     for (std::size_t k = 0; k < a.size(); ++k)
@@ -143,11 +144,9 @@ double rms_residual_deg(const std::vector<Match>& matches, const std::vector<glm
 
 }  // namespace
 
-RefinementResult refine_orientations(const std::vector<FrameFeatures>& features,
-                                     const std::vector<glm::dquat>& tracker, const RefinementSettings& s,
-                                     const std::vector<int>& groups_in) {
-  if (features.size() != tracker.size())
-    throw InputError("envmap: refinement needs one tracker rotation per frame");
+RefinementResult refine_orientations(const std::vector<FrameFeatures>& features, const std::vector<glm::dquat>& tracker,
+                                     const RefinementSettings& s, const std::vector<int>& groups_in) {
+  if (features.size() != tracker.size()) throw InputError("envmap: refinement needs one tracker rotation per frame");
   if (!groups_in.empty() && groups_in.size() != features.size())
     throw InputError("envmap: refinement needs one group per frame (or none)");
   const int n = int(features.size());

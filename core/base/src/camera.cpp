@@ -58,8 +58,8 @@ glm::dmat4 opengl_projection(const CameraIntrinsics& c, double n, double f) {
 
 glm::dmat4 opengl_view(const Pose& T_world_camera) {
   // eye = diag(1, -1, -1) * T_camera_world
-  const glm::dmat4 flip = glm::dmat4(glm::dvec4(1, 0, 0, 0), glm::dvec4(0, -1, 0, 0),
-                                     glm::dvec4(0, 0, -1, 0), glm::dvec4(0, 0, 0, 1));
+  const glm::dmat4 flip =
+      glm::dmat4(glm::dvec4(1, 0, 0, 0), glm::dvec4(0, -1, 0, 0), glm::dvec4(0, 0, -1, 0), glm::dvec4(0, 0, 0, 1));
   return flip * T_world_camera.inverse().matrix();
 }
 

@@ -18,7 +18,9 @@ constexpr char kMagic[8] = {'L', 'U', 'M', 'A', 'R', 'I', 'V', '2'};
 struct Writer {
   std::ofstream out;
   template <class T>
-  void value(const T& v) { out.write(reinterpret_cast<const char*>(&v), sizeof(T)); }
+  void value(const T& v) {
+    out.write(reinterpret_cast<const char*>(&v), sizeof(T));
+  }
   template <class T>
   void vector(const std::vector<T>& v) {
     value(std::uint64_t(v.size()));
@@ -38,7 +40,8 @@ struct Reader {
   void vector(std::vector<T>& v) {
     std::uint64_t n = 0;
     value(n);
-    if (n > (std::uint64_t(1) << 32)) throw InputError(name + ": irradiance volume file is corrupt; delete it to rebuild");
+    if (n > (std::uint64_t(1) << 32))
+      throw InputError(name + ": irradiance volume file is corrupt; delete it to rebuild");
     v.resize(std::size_t(n));
     in.read(reinterpret_cast<char*>(v.data()), std::streamsize(n * sizeof(T)));
     if (!in) throw InputError(name + ": irradiance volume file is truncated; delete it to rebuild");
@@ -62,7 +65,9 @@ struct Fnv {
     for (std::size_t i = 0; i < n; ++i) h = (h ^ b[i]) * 1099511628211ull;
   }
   template <class T>
-  void value(const T& v) { bytes(&v, sizeof(T)); }
+  void value(const T& v) {
+    bytes(&v, sizeof(T));
+  }
 };
 
 }  // namespace
@@ -114,7 +119,8 @@ IrradianceVolume IrradianceVolume::load(const std::filesystem::path& file) {
   r.value(v.box_min), r.value(v.box_max), r.value(v.cells), r.value(v.cell_size);
   r.vector(v.refined), r.vector(v.node_probe), r.vector(v.node_weight), r.vector(v.probes);
   r.value(v.irradiance_n), r.value(v.depth_n), r.value(v.atlas_columns);
-  r.vector(v.irradiance_atlas), r.vector(v.depth_atlas), r.vector(v.sh), r.vector(v.lights), r.vector(v.light_visibility);
+  r.vector(v.irradiance_atlas), r.vector(v.depth_atlas), r.vector(v.sh), r.vector(v.lights),
+      r.vector(v.light_visibility);
   r.value(v.capture_position), r.value(v.normal_bias);
   r.value(v.shadow_n), r.vector(v.light_shadow);
   // Sizes must agree, or evaluate would read out of bounds.
@@ -123,9 +129,11 @@ IrradianceVolume IrradianceVolume::load(const std::filesystem::path& file) {
   bool ok = P > 0 && v.atlas_columns > 0 && v.node_probe.size() == v.node_weight.size() &&
             v.light_visibility.size() == P * v.lights.size() && v.shadow_n >= 0 && v.shadow_n <= 4096 &&
             v.light_shadow.size() == std::size_t(v.shadow_n) * std::size_t(v.shadow_n) * v.lights.size();
-  if (!v.distant_) ok = ok && v.node_probe.size() == F && v.refined.size() == std::size_t(v.cells.x) * v.cells.y * v.cells.z;
+  if (!v.distant_)
+    ok = ok && v.node_probe.size() == F && v.refined.size() == std::size_t(v.cells.x) * v.cells.y * v.cells.z;
   if (v.settings_.storage != ProbeStorage::sh9)
-    ok = ok && v.irradiance_atlas.size() == std::size_t(v.atlas_width(v.irradiance_n)) * v.atlas_height(v.irradiance_n) * 3;
+    ok = ok &&
+         v.irradiance_atlas.size() == std::size_t(v.atlas_width(v.irradiance_n)) * v.atlas_height(v.irradiance_n) * 3;
   if (v.settings_.storage != ProbeStorage::octahedral) ok = ok && v.sh.size() == P * 27;
   if (!v.distant_)
     ok = ok && v.depth_atlas.size() == std::size_t(v.atlas_width(v.depth_n)) * v.atlas_height(v.depth_n) * 2;

@@ -88,14 +88,16 @@ glm::dvec3 reference_irradiance(const RoomRadiance& room, const glm::dvec3& poin
   glm::dvec3 bright(0.0);
   for (const BrightTexel& t : room.bright_texels()) {
     glm::dvec3 toward;
-    const double omega = room.solid_angle_from(p, t.on_proxy, t.position, t.normal, t.direction, t.solid_angle, &toward);
+    const double omega =
+        room.solid_angle_from(p, t.on_proxy, t.position, t.normal, t.direction, t.solid_angle, &toward);
     const double cosine = glm::dot(n, toward);
     if (omega <= 0.0 || cosine <= 0.0) continue;
     if (room.sees(p, t.on_proxy, t.position, t.direction)) bright += t.radiance * omega * cosine;
   }
   glm::dvec3 tangent, bitangent;
   basis(n, tangent, bitangent);
-  const std::size_t seed = std::hash<double>{}(point.x * 1e3 + point.y * 7e3 + point.z * 13e3 + n.x * 3 + n.y * 5 + n.z * 11);
+  const std::size_t seed =
+      std::hash<double>{}(point.x * 1e3 + point.y * 7e3 + point.z * 13e3 + n.x * 3 + n.y * 5 + n.z * 11);
   std::mt19937 rng{std::uint32_t(seed)};
   std::uniform_real_distribution<double> jitter(0.0, 1.0);
   glm::dvec3 dim(0.0);

@@ -30,14 +30,22 @@ VolumeSettings scene_volume_settings(const Scene& scene, const std::string& meth
       if (!value.is_boolean()) throw InputError(where + "." + key + ": expected true or false");
       return value.get<bool>();
     };
-    if (key == "spacing") s.spacing = number(0.02, 100.0);
-    else if (key == "rays_per_probe") s.rays_per_probe = int(number(16, 65536));
-    else if (key == "octahedral_resolution") s.octahedral_resolution = int(number(2, 64));
-    else if (key == "max_lights") s.radiance.max_lights = int(number(0, 32));
-    else if (key == "refine") s.refine = boolean();
-    else if (key == "visibility") s.visibility = boolean();
-    else throw InputError(where + "." + key + ": unknown key; use spacing, rays_per_probe, octahedral_resolution, "
-                          "max_lights, refine or visibility");
+    if (key == "spacing")
+      s.spacing = number(0.02, 100.0);
+    else if (key == "rays_per_probe")
+      s.rays_per_probe = int(number(16, 65536));
+    else if (key == "octahedral_resolution")
+      s.octahedral_resolution = int(number(2, 64));
+    else if (key == "max_lights")
+      s.radiance.max_lights = int(number(0, 32));
+    else if (key == "refine")
+      s.refine = boolean();
+    else if (key == "visibility")
+      s.visibility = boolean();
+    else
+      throw InputError(where + "." + key +
+                       ": unknown key; use spacing, rays_per_probe, octahedral_resolution, "
+                       "max_lights, refine or visibility");
   }
   return s;
 }
@@ -48,7 +56,8 @@ std::unique_ptr<RoomRadiance> scene_radiance(const Scene& scene, const RadianceS
   map.azimuth_offset_deg = scene.azimuth_offset_deg;
   if (scene.distant_map || scene.room_mesh.empty()) return std::make_unique<RoomRadiance>(map, settings);
   const double k = scene.room_scale;
-  return std::make_unique<RoomRadiance>(map, transformed(load_mesh(scene.room_mesh), glm::dmat4(glm::dmat3(k))), settings);
+  return std::make_unique<RoomRadiance>(map, transformed(load_mesh(scene.room_mesh), glm::dmat4(glm::dmat3(k))),
+                                        settings);
 }
 
 }  // namespace lumar

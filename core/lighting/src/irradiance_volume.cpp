@@ -18,7 +18,7 @@ namespace {
 
 constexpr double kPi = std::numbers::pi;
 constexpr double kDepthSharpness = 20.0;  // cosine power that spreads ray distances over moment texels
-constexpr int kShadowResolution = 128;     // light shadow maps: ~1.4 degrees per texel
+constexpr int kShadowResolution = 128;    // light shadow maps: ~1.4 degrees per texel
 
 std::vector<glm::dvec3> fibonacci_directions(int count) {
   std::vector<glm::dvec3> out(std::size_t(std::max(count, 1)));
@@ -36,8 +36,15 @@ std::vector<glm::dvec3> fibonacci_directions(int count) {
 std::array<double, 9> sh_basis(const glm::dvec3& d) {
   const double y00 = 0.5 / std::sqrt(kPi), y1 = std::sqrt(3.0 / (4.0 * kPi));
   const double y2 = 0.5 * std::sqrt(15.0 / kPi), y20 = 0.25 * std::sqrt(5.0 / kPi), y22 = 0.25 * std::sqrt(15.0 / kPi);
-  return {y00, y1 * d.y, y1 * d.z, y1 * d.x, y2 * d.x * d.y, y2 * d.y * d.z, y20 * (3.0 * d.z * d.z - 1.0),
-          y2 * d.x * d.z, y22 * (d.x * d.x - d.y * d.y)};
+  return {y00,
+          y1 * d.y,
+          y1 * d.z,
+          y1 * d.x,
+          y2 * d.x * d.y,
+          y2 * d.y * d.z,
+          y20 * (3.0 * d.z * d.z - 1.0),
+          y2 * d.x * d.z,
+          y22 * (d.x * d.x - d.y * d.y)};
 }
 
 struct Contribution {
@@ -166,8 +173,9 @@ struct ProbeBuilder {
         const double omega = latlong_pixel_solid_angle(row, m.width, m.height);
         for (int col = 0; col < m.width; ++col) {
           if (r.is_bright(col, row)) continue;
-          distant_dim.push_back({glm::normalize(m.world_direction(latlong_pixel_direction(col, row, m.width, m.height))),
-                                 glm::dvec3(m.texel(col, row)) * omega});
+          distant_dim.push_back(
+              {glm::normalize(m.world_direction(latlong_pixel_direction(col, row, m.width, m.height))),
+               glm::dvec3(m.texel(col, row)) * omega});
         }
       }
     }
@@ -226,7 +234,7 @@ struct ProbeBuilder {
   struct Result {
     std::vector<float> irradiance;  // n*n RGB
     std::array<float, 27> sh{};
-    std::vector<float> depth;       // d*d RG
+    std::vector<float> depth;  // d*d RG
     std::vector<float> light_visibility;
   };
 
@@ -252,7 +260,8 @@ struct ProbeBuilder {
     for (std::size_t t = 0; t < bright.size(); ++t) {
       const BrightTexel& b = bright[t];
       glm::dvec3 toward;
-      const double omega = radiance.solid_angle_from(p, b.on_proxy, b.position, b.normal, b.direction, b.solid_angle, &toward);
+      const double omega =
+          radiance.solid_angle_from(p, b.on_proxy, b.position, b.normal, b.direction, b.solid_angle, &toward);
       visible[t] = omega > 0.0 && radiance.sees(p, b.on_proxy, b.position, b.direction);
       if (settings.separate_lights && b.light >= 0) continue;
       if (visible[t]) contributions.push_back({toward, b.radiance * omega});
@@ -282,8 +291,8 @@ struct ProbeBuilder {
     if (settings.storage != ProbeStorage::sh9) {
       SH9 sh9;
       for (int i = 0; i < 9; ++i)
-        sh9.coefficients[std::size_t(i)] = glm::dvec3(out.sh[std::size_t(i * 3)], out.sh[std::size_t(i * 3 + 1)],
-                                                      out.sh[std::size_t(i * 3 + 2)]);
+        sh9.coefficients[std::size_t(i)] =
+            glm::dvec3(out.sh[std::size_t(i * 3)], out.sh[std::size_t(i * 3 + 1)], out.sh[std::size_t(i * 3 + 2)]);
       const bool delta = settings.storage == ProbeStorage::sh9_octahedral;
       out.irradiance.assign(irradiance_directions.size() * 3, 0.0f);
       for (std::size_t k = 0; k < irradiance_directions.size(); ++k) {
@@ -360,7 +369,8 @@ IrradianceVolume IrradianceVolume::build(const RoomRadiance& radiance, const glm
   v.box_max = glm::max(box_max, glm::max(box_min, box_max) + 1e-3);
   v.capture_position = radiance.working_map().capture_position;
   const glm::dvec3 extent = v.box_max - v.box_min;
-  for (int a = 0; a < 3; ++a) v.cells[a] = std::max(2, int(std::ceil(extent[a] / std::max(settings.spacing, 1e-3) - 1e-9)));
+  for (int a = 0; a < 3; ++a)
+    v.cells[a] = std::max(2, int(std::ceil(extent[a] / std::max(settings.spacing, 1e-3) - 1e-9)));
   v.cell_size = extent / glm::dvec3(v.cells);
   const glm::ivec3 C = v.cells;
   const auto cell_index = [&](int x, int y, int z) { return (std::size_t(z) * C.y + y) * C.x + x; };
@@ -397,8 +407,10 @@ IrradianceVolume IrradianceVolume::build(const RoomRadiance& radiance, const glm
     if (I.x % 2 == 0 && I.y % 2 == 0 && I.z % 2 == 0) return true;
     int lo[3], hi[3];
     for (int a = 0; a < 3; ++a) {
-      if (I[a] % 2) lo[a] = hi[a] = (I[a] - 1) / 2;
-      else lo[a] = std::max(0, I[a] / 2 - 1), hi[a] = std::min(C[a] - 1, I[a] / 2);
+      if (I[a] % 2)
+        lo[a] = hi[a] = (I[a] - 1) / 2;
+      else
+        lo[a] = std::max(0, I[a] / 2 - 1), hi[a] = std::min(C[a] - 1, I[a] / 2);
     }
     for (int z = lo[2]; z <= hi[2]; ++z)
       for (int y = lo[1]; y <= hi[1]; ++y)
@@ -435,8 +447,10 @@ IrradianceVolume IrradianceVolume::build(const RoomRadiance& radiance, const glm
           bool valid = true;
           for (int a = 0; a < 3; ++a) {
             const int bit = (corner >> a) & 1;
-            if (I[a] % 2) J[a] = I[a] - 1 + 2 * bit;
-            else if (bit) valid = false;
+            if (I[a] % 2)
+              J[a] = I[a] - 1 + 2 * bit;
+            else if (bit)
+              valid = false;
           }
           if (!valid) continue;
           v.node_probe[i][std::size_t(count)] = node_to_probe[node_index(J.x, J.y, J.z)];
@@ -504,7 +518,8 @@ IrradianceVolume IrradianceVolume::build(const RoomRadiance& radiance, const glm
     v.stats_.moved += moved[std::size_t(k)];
     if (!enabled[std::size_t(k)]) continue;
     if (settings.storage != ProbeStorage::sh9)
-      write_block<3>(v.irradiance_atlas, v.atlas_width(v.irradiance_n), v.irradiance_n, v.atlas_columns, k, r.irradiance);
+      write_block<3>(v.irradiance_atlas, v.atlas_width(v.irradiance_n), v.irradiance_n, v.atlas_columns, k,
+                     r.irradiance);
     if (settings.storage != ProbeStorage::octahedral)
       std::copy(r.sh.begin(), r.sh.end(), v.sh.begin() + std::ptrdiff_t(k) * 27);
     write_block<2>(v.depth_atlas, v.atlas_width(v.depth_n), v.depth_n, v.atlas_columns, k, r.depth);
@@ -517,8 +532,9 @@ IrradianceVolume IrradianceVolume::build(const RoomRadiance& radiance, const glm
   v.stats_.rays = radiance.traced_rays() - rays_before;
   v.stats_.fallback_rays = radiance.fallback_rays() - fallback_before;
   v.stats_.build_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-  v.stats_.bytes = (v.irradiance_atlas.size() + v.sh.size() + v.depth_atlas.size() + v.light_visibility.size() + v.light_shadow.size() +
-                    v.probes.size() * 4 + v.node_probe.size() * 8 + v.refined.size()) * sizeof(float);
+  v.stats_.bytes = (v.irradiance_atlas.size() + v.sh.size() + v.depth_atlas.size() + v.light_visibility.size() +
+                    v.light_shadow.size() + v.probes.size() * 4 + v.node_probe.size() * 8 + v.refined.size()) *
+                   sizeof(float);
   return v;
 }
 
@@ -536,8 +552,11 @@ double IrradianceVolume::light_shadow_visibility(std::size_t l, const glm::dvec3
   // Bias grows with distance: neighbouring texels' rays meet a surface at other depths.
   const double limit = r - 0.02 - 0.02 * r;
   const float* map = &light_shadow[l * std::size_t(n) * std::size_t(n)];
-  const auto lit = [&](int i, int j) { return map[std::size_t(j) * std::size_t(n) + std::size_t(i)] >= limit ? 1.0 : 0.0; };
-  return (1 - fy) * ((1 - fx) * lit(x0, y0) + fx * lit(x0 + 1, y0)) + fy * ((1 - fx) * lit(x0, y0 + 1) + fx * lit(x0 + 1, y0 + 1));
+  const auto lit = [&](int i, int j) {
+    return map[std::size_t(j) * std::size_t(n) + std::size_t(i)] >= limit ? 1.0 : 0.0;
+  };
+  return (1 - fy) * ((1 - fx) * lit(x0, y0) + fx * lit(x0 + 1, y0)) +
+         fy * ((1 - fx) * lit(x0, y0 + 1) + fx * lit(x0 + 1, y0 + 1));
 }
 
 glm::dvec3 IrradianceVolume::evaluate(const glm::dvec3& p, const glm::dvec3& normal) const {
@@ -547,9 +566,9 @@ glm::dvec3 IrradianceVolume::evaluate(const glm::dvec3& p, const glm::dvec3& nor
     if (settings_.storage != ProbeStorage::octahedral) {
       SH9 sh9;
       for (int i = 0; i < 9; ++i)
-        sh9.coefficients[std::size_t(i)] = glm::dvec3(sh[std::size_t(k) * 27 + std::size_t(i) * 3],
-                                                      sh[std::size_t(k) * 27 + std::size_t(i) * 3 + 1],
-                                                      sh[std::size_t(k) * 27 + std::size_t(i) * 3 + 2]);
+        sh9.coefficients[std::size_t(i)] =
+            glm::dvec3(sh[std::size_t(k) * 27 + std::size_t(i) * 3], sh[std::size_t(k) * 27 + std::size_t(i) * 3 + 1],
+                       sh[std::size_t(k) * 27 + std::size_t(i) * 3 + 2]);
       e = sh9_irradiance(sh9, n);
     }
     if (settings_.storage != ProbeStorage::sh9) {

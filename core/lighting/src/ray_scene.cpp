@@ -22,7 +22,8 @@ void report_embree_error(void*, RTCError code, const char* message) {
 RTCDevice shared_device() {
   static RTCDevice device = [] {
     RTCDevice d = rtcNewDevice("threads=0");
-    if (!d) throw RuntimeError("Embree: cannot create a device (" + std::to_string(int(rtcGetDeviceError(nullptr))) + ")");
+    if (!d)
+      throw RuntimeError("Embree: cannot create a device (" + std::to_string(int(rtcGetDeviceError(nullptr))) + ")");
     rtcSetDeviceErrorFunction(d, report_embree_error, nullptr);
     return d;
   }();
@@ -69,8 +70,8 @@ RTCRay to_rtc(const Ray& ray) {
 struct RayScene::Impl {
   RTCDevice device = shared_device();
   RTCScene top = rtcNewScene(device);
-  std::vector<RTCScene> instanced;      // one scene per instance's mesh
-  std::vector<RTCGeometry> instances;   // instance geometries, by instance id
+  std::vector<RTCScene> instanced;     // one scene per instance's mesh
+  std::vector<RTCGeometry> instances;  // instance geometries, by instance id
   std::vector<glm::dmat4> instance_to_world;
   std::vector<unsigned> static_geom_ids;
   bool any_geometry = false;

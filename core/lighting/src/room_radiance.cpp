@@ -195,7 +195,8 @@ void RoomRadiance::prepare(const EnvironmentMap& loaded) {
       light.solid_angle += t.solid_angle;
       dir_sum += t.direction * luminance(t.radiance) * t.solid_angle;
     }
-    light.direction = glm::length(dir_sum) > 0.0 ? glm::normalize(dir_sum) : bright_[std::size_t(light.texels[0])].direction;
+    light.direction =
+        glm::length(dir_sum) > 0.0 ? glm::normalize(dir_sum) : bright_[std::size_t(light.texels[0])].direction;
     clusters.push_back(std::move(light));
   }
   std::vector<int> candidates;

@@ -73,8 +73,7 @@ glm::dvec3 sh9_irradiance(const SH9& sh, const glm::dvec3& normal) {
   const auto& L = sh.coefficients;
   const double x = normal.x, y = normal.y, z = normal.z;
   return c1 * L[8] * (x * x - y * y) + c3 * L[6] * z * z + c4 * L[0] - c5 * L[6] +
-         2.0 * c1 * (L[4] * x * y + L[7] * x * z + L[5] * y * z) +
-         2.0 * c2 * (L[3] * x + L[1] * y + L[2] * z);
+         2.0 * c1 * (L[4] * x * y + L[7] * x * z + L[5] * y * z) + 2.0 * c2 * (L[3] * x + L[1] * y + L[2] * z);
 }
 
 }  // namespace lumar

@@ -2,13 +2,13 @@
 
 #include <spdlog/spdlog.h>
 
-#include "lumar/scene/envmap.h"
 #include "lumar/lighting/irradiance_scene.h"
 #include "lumar/lighting/irradiance_volume.h"
-#include "lumar/scene/mesh.h"
 #include "lumar/lighting/shadows/object_shadows.h"
 #include "lumar/lighting/shadows/shadow_methods.h"
 #include "lumar/lighting/shadows/shadow_occlusion.h"
+#include "lumar/scene/envmap.h"
+#include "lumar/scene/mesh.h"
 
 namespace lumar {
 
@@ -85,8 +85,7 @@ void Compositor::build_shadows(const Scene& scene) {
   if (objects.size() >= 2) {
     object_shadows_ = std::make_shared<ObjectShadows>(emitters);
     for (const auto& o : objects) object_shadows_->add_object(o.model, o.T_world_model);
-    spdlog::debug("objects shadow each other: {} objects, {} emitter samples", objects.size(),
-                  emitters.samples.size());
+    spdlog::debug("objects shadow each other: {} objects, {} emitter samples", objects.size(), emitters.samples.size());
   }
 }
 

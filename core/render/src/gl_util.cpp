@@ -43,21 +43,28 @@ GlName compile_shader(const char* program_name, GLenum stage, const char* source
 
 const char* error_name(GLenum e) {
   switch (e) {
-    case GL_INVALID_ENUM: return "GL_INVALID_ENUM";
-    case GL_INVALID_VALUE: return "GL_INVALID_VALUE";
-    case GL_INVALID_OPERATION: return "GL_INVALID_OPERATION";
-    case GL_INVALID_FRAMEBUFFER_OPERATION: return "GL_INVALID_FRAMEBUFFER_OPERATION";
-    case GL_OUT_OF_MEMORY: return "GL_OUT_OF_MEMORY";
-    case GL_STACK_OVERFLOW: return "GL_STACK_OVERFLOW";
-    case GL_STACK_UNDERFLOW: return "GL_STACK_UNDERFLOW";
-    default: return "unknown GL error";
+    case GL_INVALID_ENUM:
+      return "GL_INVALID_ENUM";
+    case GL_INVALID_VALUE:
+      return "GL_INVALID_VALUE";
+    case GL_INVALID_OPERATION:
+      return "GL_INVALID_OPERATION";
+    case GL_INVALID_FRAMEBUFFER_OPERATION:
+      return "GL_INVALID_FRAMEBUFFER_OPERATION";
+    case GL_OUT_OF_MEMORY:
+      return "GL_OUT_OF_MEMORY";
+    case GL_STACK_OVERFLOW:
+      return "GL_STACK_OVERFLOW";
+    case GL_STACK_UNDERFLOW:
+      return "GL_STACK_UNDERFLOW";
+    default:
+      return "unknown GL error";
   }
 }
 
 }  // namespace
 
-GlName create_texture_2d(GLenum internal_format, int width, int height, GLenum filter,
-                         GLenum wrap_s, GLenum wrap_t) {
+GlName create_texture_2d(GLenum internal_format, int width, int height, GLenum filter, GLenum wrap_s, GLenum wrap_t) {
   GLuint id = 0;
   glCreateTextures(GL_TEXTURE_2D, 1, &id);
   GlName texture(id, delete_texture);
@@ -114,8 +121,8 @@ GlName create_program(const char* name, const char* vertex_source, const char* f
     glGetProgramiv(program.get(), GL_INFO_LOG_LENGTH, &length);
     std::string log(std::max(length, 1), '\0');
     glGetProgramInfoLog(program.get(), length, nullptr, log.data());
-    throw RuntimeError(std::string("OpenGL: the ") + name + " program does not link: " +
-                       one_line(log.c_str()) + " (a bug in lumar; report it with the GL renderer name)");
+    throw RuntimeError(std::string("OpenGL: the ") + name + " program does not link: " + one_line(log.c_str()) +
+                       " (a bug in lumar; report it with the GL renderer name)");
   }
   return program;
 }

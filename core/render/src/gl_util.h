@@ -40,8 +40,7 @@ class GlName {
   Deleter deleter_ = nullptr;
 };
 
-GlName create_texture_2d(GLenum internal_format, int width, int height, GLenum filter,
-                         GLenum wrap_s, GLenum wrap_t);
+GlName create_texture_2d(GLenum internal_format, int width, int height, GLenum filter, GLenum wrap_s, GLenum wrap_t);
 // `flags`: glNamedBufferStorage's (GL_DYNAMIC_STORAGE_BIT: updatable with glNamedBufferSubData).
 GlName create_buffer(const void* data, std::size_t bytes, GLbitfield flags = 0);
 GlName create_framebuffer();

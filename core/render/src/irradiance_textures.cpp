@@ -176,7 +176,8 @@ vec3 volume_irradiance(vec3 p, vec3 n) {
 }
 )glsl";
 
-IrradianceTextures::BufferTexture IrradianceTextures::buffer_texture(GLenum format, const void* data, std::size_t bytes) {
+IrradianceTextures::BufferTexture IrradianceTextures::buffer_texture(GLenum format, const void* data,
+                                                                     std::size_t bytes) {
   BufferTexture t;
   static const float zero[4] = {0, 0, 0, 0};
   t.buffer = create_buffer(bytes ? data : zero, bytes ? bytes : sizeof(zero));
@@ -201,8 +202,9 @@ GlName IrradianceTextures::atlas(GLenum internal_format, GLenum format, int widt
 
 IrradianceTextures::IrradianceTextures(const IrradianceVolume& v) {
   if (v.lights.size() > std::size_t(kMaxVolumeLights))
-    throw InputError("irradiance volume has " + std::to_string(v.lights.size()) + " lights; the GPU path takes at most " +
-                     std::to_string(kMaxVolumeLights) + " (lower lighting.irradiance.max_lights)");
+    throw InputError("irradiance volume has " + std::to_string(v.lights.size()) +
+                     " lights; the GPU path takes at most " + std::to_string(kMaxVolumeLights) +
+                     " (lower lighting.irradiance.max_lights)");
   probes_ = buffer_texture(GL_RGBA32F, v.probes.data(), v.probes.size() * sizeof(glm::vec4));
   node_probe_ = buffer_texture(GL_RGBA32I, v.node_probe.data(), v.node_probe.size() * sizeof(std::array<int, 4>));
   node_weight_ = buffer_texture(GL_RGBA32F, v.node_weight.data(), v.node_weight.size() * sizeof(std::array<float, 4>));
@@ -214,7 +216,8 @@ IrradianceTextures::IrradianceTextures(const IrradianceVolume& v) {
   sh_ = buffer_texture(GL_RGBA32F, sh_rgba.data(), sh_rgba.size() * sizeof(float));
   std::vector<float> visibility_and_shadows = v.light_visibility;
   visibility_and_shadows.insert(visibility_and_shadows.end(), v.light_shadow.begin(), v.light_shadow.end());
-  light_visibility_ = buffer_texture(GL_R32F, visibility_and_shadows.data(), visibility_and_shadows.size() * sizeof(float));
+  light_visibility_ =
+      buffer_texture(GL_R32F, visibility_and_shadows.data(), visibility_and_shadows.size() * sizeof(float));
   shadow_offset_ = int(v.light_visibility.size());
   const bool has_irradiance = !v.irradiance_atlas.empty();
   irradiance_ = atlas(GL_RGB32F, GL_RGB, has_irradiance ? v.atlas_width(v.irradiance_n) : 1,
@@ -230,7 +233,8 @@ IrradianceTextures::IrradianceTextures(const IrradianceVolume& v) {
   visibility_ = v.settings().visibility;
   distant_ = v.distant();
   bytes_ = (v.probes.size() * 4 + v.node_probe.size() * 8 + refined.size() + v.sh.size() + v.light_visibility.size() +
-            v.light_shadow.size() + v.irradiance_atlas.size() + v.depth_atlas.size()) * 4;
+            v.light_shadow.size() + v.irradiance_atlas.size() + v.depth_atlas.size()) *
+           4;
   check_gl_errors("IrradianceTextures");
 }
 

@@ -2,8 +2,8 @@
 
 #include <algorithm>
 #include <array>
-#include <cmath>
 #include <chrono>
+#include <cmath>
 #include <glm/gtc/matrix_transform.hpp>
 #include <glm/gtc/type_ptr.hpp>
 #include <string>
@@ -12,9 +12,9 @@
 #include "gl_util.h"
 #include "gpu_mesh.h"
 #include "irradiance_textures.h"
+#include "lumar/base/error.h"
 #include "shaders.h"
 #include "shadow_pass.h"
-#include "lumar/base/error.h"
 
 namespace lumar::gl {
 namespace {
@@ -25,14 +25,12 @@ struct RenderTarget {
   GlName framebuffer, color, depth;
 
   RenderTarget() = default;
-  RenderTarget(int w, int h, GLenum color_format, bool with_depth, const char* what)
-      : width(w), height(h) {
+  RenderTarget(int w, int h, GLenum color_format, bool with_depth, const char* what) : width(w), height(h) {
     framebuffer = create_framebuffer();
     color = create_texture_2d(color_format, w, h, GL_NEAREST, GL_CLAMP_TO_EDGE, GL_CLAMP_TO_EDGE);
     glNamedFramebufferTexture(framebuffer.get(), GL_COLOR_ATTACHMENT0, color.get(), 0);
     if (with_depth) {
-      depth = create_texture_2d(GL_DEPTH_COMPONENT32F, w, h, GL_NEAREST, GL_CLAMP_TO_EDGE,
-                                GL_CLAMP_TO_EDGE);
+      depth = create_texture_2d(GL_DEPTH_COMPONENT32F, w, h, GL_NEAREST, GL_CLAMP_TO_EDGE, GL_CLAMP_TO_EDGE);
       glNamedFramebufferTexture(framebuffer.get(), GL_DEPTH_ATTACHMENT, depth.get(), 0);
     }
     glNamedFramebufferDrawBuffer(framebuffer.get(), GL_COLOR_ATTACHMENT0);
@@ -116,9 +114,9 @@ struct Renderer::Impl {
   glm::vec3 capture_position{0.0f};
   glm::mat3 map_from_world{1.0f};
 
-  RenderTarget scene;         // linear colour (RGBA32F) and depth, output size
-  RenderTarget encoded;       // sRGB 8-bit, output size, rows flipped for read-back
-  RenderTarget room_target;   // for render_room_radiance, resized on demand
+  RenderTarget scene;        // linear colour (RGBA32F) and depth, output size
+  RenderTarget encoded;      // sRGB 8-bit, output size, rows flipped for read-back
+  RenderTarget room_target;  // for render_room_radiance, resized on demand
 
   Object& object(int id, const char* where) {
     if (id < 0 || id >= int(objects.size()))
@@ -134,10 +132,8 @@ struct Renderer::Impl {
   static void set_transform(GLuint program, const glm::mat4& model, const glm::mat3& normal_matrix,
                             const glm::mat4& vp) {
     glProgramUniformMatrix4fv(program, uniform(program, "model"), 1, GL_FALSE, glm::value_ptr(model));
-    glProgramUniformMatrix3fv(program, uniform(program, "normal_matrix"), 1, GL_FALSE,
-                              glm::value_ptr(normal_matrix));
-    glProgramUniformMatrix4fv(program, uniform(program, "view_projection"), 1, GL_FALSE,
-                              glm::value_ptr(vp));
+    glProgramUniformMatrix3fv(program, uniform(program, "normal_matrix"), 1, GL_FALSE, glm::value_ptr(normal_matrix));
+    glProgramUniformMatrix4fv(program, uniform(program, "view_projection"), 1, GL_FALSE, glm::value_ptr(vp));
   }
 
   // The proxy room into depth only: real surfaces hide virtual objects behind them.
@@ -172,8 +168,7 @@ struct Renderer::Impl {
 
   void upload_video(const cv::Mat& frame) {
     if (frame.cols != video_width || frame.rows != video_height) {
-      video = create_texture_2d(GL_RGB8, frame.cols, frame.rows, GL_LINEAR, GL_CLAMP_TO_EDGE,
-                                GL_CLAMP_TO_EDGE);
+      video = create_texture_2d(GL_RGB8, frame.cols, frame.rows, GL_LINEAR, GL_CLAMP_TO_EDGE, GL_CLAMP_TO_EDGE);
       video_width = frame.cols;
       video_height = frame.rows;
     }
@@ -203,8 +198,7 @@ Renderer::Renderer(const CameraIntrinsics& camera) : impl_(std::make_unique<Impl
     throw InputError("Renderer: invalid output camera (" + std::to_string(camera.width) + "x" +
                      std::to_string(camera.height) + ", fx " + std::to_string(camera.fx) +
                      "); check the camera calibration file");
-  if (!any_context_current())
-    throw RuntimeError("Renderer: no OpenGL context is current; create a gl::Context first");
+  if (!any_context_current()) throw RuntimeError("Renderer: no OpenGL context is current; create a gl::Context first");
   Impl& r = *impl_;
   r.camera = camera.without_distortion();
   r.empty_vertex_array = create_vertex_array();
@@ -238,8 +232,7 @@ void Renderer::set_receivers(const Mesh& receivers_world) {
 }
 
 void Renderer::set_receiver_attenuation(std::span<const glm::vec3> attenuation) {
-  if (!impl_->receivers)
-    throw InputError("Renderer::set_receiver_attenuation: no receivers; call set_receivers first");
+  if (!impl_->receivers) throw InputError("Renderer::set_receiver_attenuation: no receivers; call set_receivers first");
   impl_->receivers->set_attenuation(attenuation);
 }
 
@@ -248,16 +241,15 @@ void Renderer::set_environment(const EnvironmentMap& map) {
     throw InputError("Renderer::set_environment: environment map is empty or its pixel count does not match " +
                      std::to_string(map.width) + "x" + std::to_string(map.height) + "; load it again");
   Impl& r = *impl_;
-  r.environment = create_texture_2d(GL_RGB32F, map.width, map.height, GL_LINEAR, GL_REPEAT,
-                                    GL_CLAMP_TO_EDGE);
+  r.environment = create_texture_2d(GL_RGB32F, map.width, map.height, GL_LINEAR, GL_REPEAT, GL_CLAMP_TO_EDGE);
   glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
   glPixelStorei(GL_UNPACK_ROW_LENGTH, 0);
   // Texel row 0 is the map's top row (theta = 0), so v / H is the texture's t directly.
   glTextureSubImage2D(r.environment.get(), 0, 0, 0, map.width, map.height, GL_RGB, GL_FLOAT, map.rgb.data());
   r.capture_position = glm::vec3(map.capture_position);
   // world direction = Ry(offset) * map direction, so map direction = Ry(-offset) * world direction.
-  r.map_from_world = glm::mat3(
-      glm::rotate(glm::dmat4(1.0), glm::radians(-map.azimuth_offset_deg), glm::dvec3(0, 1, 0)));
+  r.map_from_world =
+      glm::mat3(glm::rotate(glm::dmat4(1.0), glm::radians(-map.azimuth_offset_deg), glm::dvec3(0, 1, 0)));
   check_gl_errors("Renderer::set_environment");
 }
 
@@ -303,8 +295,8 @@ void Renderer::set_undistortion_map(const cv::Mat& map_x, const cv::Mat& map_y) 
                      "; make them with cv::initUndistortRectifyMap(..., CV_32FC1, ...)");
   cv::Mat xy;
   cv::merge(std::vector<cv::Mat>{map_x, map_y}, xy);
-  r.undistortion_map = create_texture_2d(GL_RG32F, size.width, size.height, GL_NEAREST,
-                                         GL_CLAMP_TO_EDGE, GL_CLAMP_TO_EDGE);
+  r.undistortion_map =
+      create_texture_2d(GL_RG32F, size.width, size.height, GL_NEAREST, GL_CLAMP_TO_EDGE, GL_CLAMP_TO_EDGE);
   glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
   glPixelStorei(GL_UNPACK_ROW_LENGTH, 0);
   glTextureSubImage2D(r.undistortion_map.get(), 0, 0, 0, size.width, size.height, GL_RG, GL_FLOAT, xy.data);
@@ -330,8 +322,10 @@ void Renderer::set_video_radiometry(const VideoRadiometry& radiometry) {
     for (int code = 0; code < 256; ++code)
       if (!std::isfinite(channel[std::size_t(code)]) || channel[std::size_t(code)] < 0.0f ||
           (code > 0 && channel[std::size_t(code)] < channel[std::size_t(code - 1)]))
-        throw InputError("Renderer::set_video_radiometry: the response is not finite, non-negative and "
-                         "non-decreasing at code " + std::to_string(code) + "; recalibrate it");
+        throw InputError(
+            "Renderer::set_video_radiometry: the response is not finite, non-negative and "
+            "non-decreasing at code " +
+            std::to_string(code) + "; recalibrate it");
   // Decode: the table itself, RGB order. Encode: its inverse sampled at linear = s^2 * max,
   // dense near black where codes are closest together in linear terms.
   constexpr int kEncodeSize = 4096;
@@ -358,8 +352,8 @@ void Renderer::set_video_radiometry(const VideoRadiometry& radiometry) {
   check_gl_errors("Renderer::set_video_radiometry");
 }
 
-cv::Mat Renderer::render_overlay(const cv::Mat& video_bgr8, const std::optional<Pose>& T_world_camera,
-                                 double exposure, OverlayTimings* timings) {
+cv::Mat Renderer::render_overlay(const cv::Mat& video_bgr8, const std::optional<Pose>& T_world_camera, double exposure,
+                                 OverlayTimings* timings) {
   if (video_bgr8.type() != CV_8UC3 || video_bgr8.empty())
     throw InputError("Renderer::render_overlay: video frame must be non-empty BGR8 (CV_8UC3); convert it first");
   Impl& r = *impl_;

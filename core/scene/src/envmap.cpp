@@ -21,13 +21,9 @@ glm::dvec3 rotate_y(const glm::dvec3& d, double angle_deg) {
 
 }  // namespace
 
-glm::dvec3 EnvironmentMap::map_direction(const glm::dvec3& world) const {
-  return rotate_y(world, -azimuth_offset_deg);
-}
+glm::dvec3 EnvironmentMap::map_direction(const glm::dvec3& world) const { return rotate_y(world, -azimuth_offset_deg); }
 
-glm::dvec3 EnvironmentMap::world_direction(const glm::dvec3& map) const {
-  return rotate_y(map, azimuth_offset_deg);
-}
+glm::dvec3 EnvironmentMap::world_direction(const glm::dvec3& map) const { return rotate_y(map, azimuth_offset_deg); }
 
 glm::vec3 EnvironmentMap::radiance(const glm::dvec3& world) const {
   const glm::dvec2 uv = latlong_coordinates(map_direction(world), width, height);
@@ -60,8 +56,7 @@ double mean_luminance(const EnvironmentMap& map) {
 
 EnvironmentMap load_environment_map(const std::filesystem::path& path) {
   const std::string name = path.string();
-  if (!std::filesystem::is_regular_file(path))
-    throw InputError(name + ": environment map not found; check the path");
+  if (!std::filesystem::is_regular_file(path)) throw InputError(name + ": environment map not found; check the path");
   auto in = OIIO::ImageInput::open(name);
   if (!in) {
     std::string why = OIIO::geterror();
@@ -71,8 +66,7 @@ EnvironmentMap load_environment_map(const std::filesystem::path& path) {
   }
   const OIIO::ImageSpec& spec = in->spec();
   const int w = spec.width, h = spec.height, channels = spec.nchannels;
-  if (w <= 0 || h <= 0 || channels <= 0)
-    throw InputError(name + ": environment map has no pixels");
+  if (w <= 0 || h <= 0 || channels <= 0) throw InputError(name + ": environment map has no pixels");
   if (w != 2 * h)
     throw InputError(name + ": environment map is " + std::to_string(w) + "x" + std::to_string(h) +
                      ", but a lat-long map must be twice as wide as high; resample it to 2:1");
@@ -88,8 +82,7 @@ EnvironmentMap load_environment_map(const std::filesystem::path& path) {
   if (!in->read_image(0, 0, 0, read_channels, OIIO::TypeDesc::FLOAT, pixels.data())) {
     std::string why = in->geterror();
     std::replace(why.begin(), why.end(), '\n', ' ');
-    throw InputError(name + ": cannot read environment map pixels (" + why +
-                     "); the file may be truncated or corrupt");
+    throw InputError(name + ": cannot read environment map pixels (" + why + "); the file may be truncated or corrupt");
   }
   in->close();
   for (std::size_t i = 0, n = std::size_t(w) * h; i < n; ++i)
@@ -98,8 +91,8 @@ EnvironmentMap load_environment_map(const std::filesystem::path& path) {
   const auto bad = std::find_if(map.rgb.begin(), map.rgb.end(), [](float v) { return !std::isfinite(v); });
   if (bad != map.rgb.end()) {
     const std::size_t pixel = std::size_t(bad - map.rgb.begin()) / 3;
-    throw InputError(name + ": environment map pixel (" + std::to_string(pixel % w) + ", " +
-                     std::to_string(pixel / w) + ") is not finite; repair the map");
+    throw InputError(name + ": environment map pixel (" + std::to_string(pixel % w) + ", " + std::to_string(pixel / w) +
+                     ") is not finite; repair the map");
   }
   return map;
 }
@@ -114,8 +107,7 @@ void save_environment_map(const std::filesystem::path& path, const EnvironmentMa
   if (!out) throw RuntimeError(name + ": OpenImageIO has no OpenEXR writer (" + OIIO::geterror() + ")");
   OIIO::ImageSpec spec(map.width, map.height, 3, OIIO::TypeDesc::FLOAT);
   spec.attribute("compression", "zip");
-  const bool ok = out->open(tmp, spec) &&
-                  out->write_image(OIIO::TypeDesc::FLOAT, map.rgb.data()) && out->close();
+  const bool ok = out->open(tmp, spec) && out->write_image(OIIO::TypeDesc::FLOAT, map.rgb.data()) && out->close();
   if (!ok) {
     std::string why = out->geterror();
     std::replace(why.begin(), why.end(), '\n', ' ');

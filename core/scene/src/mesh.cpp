@@ -14,9 +14,7 @@ namespace lumar {
 
 namespace {
 
-bool is_finite(const glm::vec3& v) {
-  return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
-}
+bool is_finite(const glm::vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
 
 // Area-weighted vertex normals: the unnormalised cross product of a triangle's edges
 // has length twice its area, so summing them weights each face by its area.
@@ -24,8 +22,7 @@ std::vector<glm::vec3> area_weighted_normals(const std::vector<glm::vec3>& posit
                                              const std::vector<std::uint32_t>& indices) {
   std::vector<glm::dvec3> sum(positions.size(), glm::dvec3(0.0));
   for (std::size_t t = 0; t + 2 < indices.size(); t += 3) {
-    const glm::dvec3 a = positions[indices[t]], b = positions[indices[t + 1]],
-                     c = positions[indices[t + 2]];
+    const glm::dvec3 a = positions[indices[t]], b = positions[indices[t + 1]], c = positions[indices[t + 2]];
     const glm::dvec3 n = glm::cross(b - a, c - a);
     for (int k = 0; k < 3; ++k) sum[indices[t + k]] += n;
   }
@@ -52,15 +49,14 @@ std::pair<glm::vec3, glm::vec3> Mesh::bounds() const {
 
 Mesh load_mesh(const std::filesystem::path& path) {
   const std::string name = path.string();
-  if (!std::filesystem::is_regular_file(path))
-    throw InputError(name + ": mesh file not found; check the path");
+  if (!std::filesystem::is_regular_file(path)) throw InputError(name + ": mesh file not found; check the path");
 
   // Pre-transforming bakes the node hierarchy's transforms into the vertices, so a glTF
   // or OBJ whose parts are placed by nodes loads where its author put it. Normals are
   // not generated here: assimp's are not area-weighted, and the file's own are kept.
   Assimp::Importer importer;
-  const unsigned flags = aiProcess_Triangulate | aiProcess_JoinIdenticalVertices |
-                         aiProcess_PreTransformVertices | aiProcess_SortByPType;
+  const unsigned flags =
+      aiProcess_Triangulate | aiProcess_JoinIdenticalVertices | aiProcess_PreTransformVertices | aiProcess_SortByPType;
   const aiScene* scene = importer.ReadFile(name, flags);
   if (!scene || (scene->mFlags & AI_SCENE_FLAGS_INCOMPLETE) || !scene->mRootNode) {
     std::string why = importer.GetErrorString();
@@ -106,8 +102,7 @@ Mesh load_mesh(const std::filesystem::path& path) {
     mesh.positions.insert(mesh.positions.end(), part_positions.begin(), part_positions.end());
     for (std::uint32_t i : part_indices) mesh.indices.push_back(base + i);
   }
-  if (mesh.indices.empty())
-    throw InputError(name + ": mesh holds no triangles; export the model with its faces");
+  if (mesh.indices.empty()) throw InputError(name + ": mesh holds no triangles; export the model with its faces");
   return mesh;
 }
 
@@ -120,14 +115,12 @@ Mesh transformed(const Mesh& mesh, const glm::dmat4& m) {
     out.positions.emplace_back(glm::dvec3(q) / q.w);
   }
   const glm::dmat3 normal_matrix = glm::transpose(glm::inverse(glm::dmat3(m)));
-  for (const auto& n : mesh.normals)
-    out.normals.emplace_back(glm::normalize(normal_matrix * glm::dvec3(n)));
+  for (const auto& n : mesh.normals) out.normals.emplace_back(glm::normalize(normal_matrix * glm::dvec3(n)));
   out.indices = mesh.indices;
   // A mirroring transform turns counter-clockwise triangles clockwise; swap two corners
   // so that the winding still agrees with the (correctly transformed) normals.
   if (glm::determinant(glm::dmat3(m)) < 0.0)
-    for (std::size_t t = 0; t + 2 < out.indices.size(); t += 3)
-      std::swap(out.indices[t + 1], out.indices[t + 2]);
+    for (std::size_t t = 0; t + 2 < out.indices.size(); t += 3) std::swap(out.indices[t + 1], out.indices[t + 2]);
   return out;
 }
 

@@ -200,13 +200,11 @@ Scene load_scene(const std::filesystem::path& manifest) {
   const json doc = parse_manifest(manifest);
   const ManifestReader r(manifest);
   if (!doc.is_object()) r.fail("(top level)", "expected a JSON object");
-  r.only_keys(doc, "", {"format", "version", "room", "environment_map", "movement_box", "objects", "lighting",
-                      "shadows"});
+  r.only_keys(doc, "",
+              {"format", "version", "room", "environment_map", "movement_box", "objects", "lighting", "shadows"});
 
-  if (!doc.contains("format") || doc.at("format") != "lumar-scene")
-    r.fail("format", "expected \"lumar-scene\"");
-  if (!doc.contains("version") || !doc.at("version").is_number_integer())
-    r.fail("version", "expected an integer");
+  if (!doc.contains("format") || doc.at("format") != "lumar-scene") r.fail("format", "expected \"lumar-scene\"");
+  if (!doc.contains("version") || !doc.at("version").is_number_integer()) r.fail("version", "expected an integer");
   if (doc.at("version").get<long long>() != 1)
     r.fail("version", "this build reads version 1; update lumar or convert the manifest");
 
@@ -242,8 +240,7 @@ Scene load_scene(const std::filesystem::path& manifest) {
   scene.movement_min = r.vec3(box.at("min"), "movement_box.min");
   scene.movement_max = r.vec3(box.at("max"), "movement_box.max");
   for (int i = 0; i < 3; ++i)
-    if (scene.movement_min[i] > scene.movement_max[i])
-      r.fail("movement_box", "min must not exceed max on any axis");
+    if (scene.movement_min[i] > scene.movement_max[i]) r.fail("movement_box", "min must not exceed max on any axis");
 
   if (doc.contains("objects")) {
     const json& objects = doc.at("objects");

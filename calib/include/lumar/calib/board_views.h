@@ -16,9 +16,9 @@ struct NamedImage {
 
 struct BoardViews {
   cv::Size image_size;
-  std::vector<std::string> names;                  // one per view with the board
-  std::vector<std::vector<cv::Point2f>> corners;   // sub-pixel image points of each view
-  std::vector<std::vector<cv::Point3f>> objects;   // the same points on the board, metres, z = 0
+  std::vector<std::string> names;                 // one per view with the board
+  std::vector<std::vector<cv::Point2f>> corners;  // sub-pixel image points of each view
+  std::vector<std::vector<cv::Point3f>> objects;  // the same points on the board, metres, z = 0
   std::vector<std::string> views_without_board;
 };
 

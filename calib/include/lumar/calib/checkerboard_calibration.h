@@ -31,7 +31,7 @@ BoardViews detect_checkerboard_views(const std::vector<NamedImage>& images, cv::
 // inner_corners: corners where four squares meet, e.g. 9x6 for a 10x7-square board.
 // The reference beside calibrate_robust: plain cv::calibrateCamera on every view.
 // Throws InputError as load_board_images and detect_checkerboard_views do.
-CalibrationResult calibrate_checkerboard(const std::vector<std::filesystem::path>& images,
-                                         cv::Size inner_corners, double square_size_m);
+CalibrationResult calibrate_checkerboard(const std::vector<std::filesystem::path>& images, cv::Size inner_corners,
+                                         double square_size_m);
 
 }  // namespace lumar::calib

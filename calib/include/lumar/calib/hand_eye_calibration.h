@@ -24,8 +24,8 @@ struct HandEyeOptions {
 
 struct HandEyeSolution {
   Pose T_sensor_camera;
-  Pose T_transmitter_board;      // mean over the views of T_transmitter_sensor * X * T_camera_board
-  std::vector<int> views_used;   // indices into the inputs given to cv::calibrateHandEye
+  Pose T_transmitter_board;          // mean over the views of T_transmitter_sensor * X * T_camera_board
+  std::vector<int> views_used;       // indices into the inputs given to cv::calibrateHandEye
   double min_pair_rotation_deg = 0;  // smallest rotation between two selected views
 };
 
@@ -41,6 +41,5 @@ std::vector<int> spread_rotations(const std::vector<glm::dquat>& rotations, int 
 // Chordal L2 mean of rotations (the normalised sum of sign-aligned quaternions, which
 // is the maximum-likelihood mean for small isotropic noise) and mean of translations.
 Pose mean_pose(const std::vector<Pose>& poses);
-
 
 }  // namespace lumar::calib

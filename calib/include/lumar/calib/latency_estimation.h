@@ -12,7 +12,7 @@
 namespace lumar::calib {
 
 struct AngularSpeedSample {
-  Nanos time = 0;             // middle of the two poses compared
+  Nanos time = 0;  // middle of the two poses compared
   double speed_deg_s = 0.0;
 };
 
@@ -37,10 +37,10 @@ struct TimeOffsetEstimate {
   // offset > 0 means the tracker's timestamps are too late, i.e. its latency is
   // larger than assumed by `offset`.
   Nanos offset = 0;
-  double peak_correlation = 0;    // Pearson correlation at the peak (1 = identical shapes)
+  double peak_correlation = 0;  // Pearson correlation at the peak (1 = identical shapes)
   double correlation_at_zero = 0;
-  int samples = 0;                // tracker speed samples compared at the peak
-  std::vector<double> curve;      // correlation at -max_offset + k * step
+  int samples = 0;            // tracker speed samples compared at the peak
+  std::vector<double> curve;  // correlation at -max_offset + k * step
 };
 
 // Each tracker speed sample is compared with the video's speed interpolated at its time

@@ -14,12 +14,12 @@
 namespace lumar::calib {
 
 struct LightingAdapterSettings {
-  double time_constant_s = 0.5;  // exponential smoothing of the measured ratio
-  double hysteresis = 0.05;      // relative change needed before the published ratio moves
+  double time_constant_s = 0.5;      // exponential smoothing of the measured ratio
+  double hysteresis = 0.05;          // relative change needed before the published ratio moves
   int grid_cols = 4, grid_rows = 3;  // regions of the image with their own ratio
-  int min_pixels = 400;          // a region with fewer usable pixels uses the global ratio
-  double min_predicted = 1e-4;   // predicted radiance below this is not compared (no room there)
-  double max_observed = 0.0;     // observed radiance at or above this is clipped (0 = no limit)
+  int min_pixels = 400;              // a region with fewer usable pixels uses the global ratio
+  double min_predicted = 1e-4;       // predicted radiance below this is not compared (no room there)
+  double max_observed = 0.0;         // observed radiance at or above this is clipped (0 = no limit)
 };
 
 class LightingAdapter {

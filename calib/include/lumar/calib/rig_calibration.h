@@ -34,7 +34,7 @@ namespace lumar::calib {
 // One video frame where the board was found.
 struct BoardView {
   std::int64_t index = 0;
-  Nanos time = 0;                  // recording time of the frame
+  Nanos time = 0;  // recording time of the frame
   Pose T_camera_board;
   double reprojection_rms_px = 0;
 };
@@ -62,8 +62,8 @@ struct RigCalibrationOptions {
 struct RigCalibrationResult {
   tracking::Rig rig;  // latency = assumed latency + time offset
   Nanos assumed_latency = 0;
-  Nanos time_offset = 0;              // final (refined) offset added to the assumed latency
-  Nanos correlation_offset = 0;       // from the angular-speed cross-correlation alone
+  Nanos time_offset = 0;         // final (refined) offset added to the assumed latency
+  Nanos correlation_offset = 0;  // from the angular-speed cross-correlation alone
   double peak_correlation = 0, correlation_at_zero = 0;
   HandEyeSolution hand_eye;           // cv::calibrateHandEye on latency-corrected poses
   int views_given = 0;                // board views passed in

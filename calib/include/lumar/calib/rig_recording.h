@@ -16,10 +16,10 @@ namespace lumar::calib {
 
 struct RigRecording {
   capture::Session session;
-  CameraIntrinsics camera;          // the one used for the board poses
-  std::vector<BoardView> views;     // frames where the whole board was found
-  int frames = 0;                   // frames read
-  tracking::PoseStream tracker;     // T_transmitter_sensor, times with session.rig.latency
+  CameraIntrinsics camera;       // the one used for the board poses
+  std::vector<BoardView> views;  // frames where the whole board was found
+  int frames = 0;                // frames read
+  tracking::PoseStream tracker;  // T_transmitter_sensor, times with session.rig.latency
   std::size_t tracker_records = 0;
 };
 

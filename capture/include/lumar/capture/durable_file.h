@@ -39,8 +39,11 @@ class AppendFile {
   void append(std::string_view bytes);  // flushes by itself once 1 MiB is queued
   void flush();                         // write(2) everything queued
   void datasync();                      // fdatasync(2) of what was flushed
-  void sync() { flush(); datasync(); }
-  void close();                         // sync, then close; RuntimeError on failure
+  void sync() {
+    flush();
+    datasync();
+  }
+  void close();  // sync, then close; RuntimeError on failure
 
  private:
   std::filesystem::path path_;

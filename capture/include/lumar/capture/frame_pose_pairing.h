@@ -15,8 +15,8 @@
 #include <optional>
 #include <vector>
 
-#include "lumar/capture/frame_source.h"
 #include "lumar/base/pose.h"
+#include "lumar/capture/frame_source.h"
 #include "lumar/tracking/pose_stream.h"
 #include "lumar/tracking/rig.h"
 
@@ -24,8 +24,8 @@ namespace lumar::capture {
 
 struct PairedFrame {
   Frame frame;
-  tracking::PoseLookup sensor;          // T_transmitter_sensor at the frame's time, and why not
-  std::optional<Pose> T_world_camera;   // the rig applied to it (nullopt: no pose)
+  tracking::PoseLookup sensor;         // T_transmitter_sensor at the frame's time, and why not
+  std::optional<Pose> T_world_camera;  // the rig applied to it (nullopt: no pose)
 };
 
 class FramePosePairing {

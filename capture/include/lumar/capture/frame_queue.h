@@ -12,20 +12,20 @@
 #include <deque>
 #include <mutex>
 
-#include "lumar/capture/frame_source.h"
 #include "lumar/base/time.h"
+#include "lumar/capture/frame_source.h"
 
 namespace lumar::capture {
 
 enum class QueuePolicy { KeepNewest, KeepAll };
 
 struct QueueStats {
-  std::uint64_t pushed = 0;          // frames offered by the producer
-  std::uint64_t popped = 0;          // frames handed to the consumer
-  std::uint64_t stale_dropped = 0;   // KeepNewest: replaced by a newer frame before being taken
-  std::uint64_t back_pressure = 0;   // KeepAll: pushes that found the queue full and waited
-  Nanos back_pressure_time = 0;      // KeepAll: total time the producer waited
-  std::size_t high_water = 0;        // most frames ever waiting
+  std::uint64_t pushed = 0;         // frames offered by the producer
+  std::uint64_t popped = 0;         // frames handed to the consumer
+  std::uint64_t stale_dropped = 0;  // KeepNewest: replaced by a newer frame before being taken
+  std::uint64_t back_pressure = 0;  // KeepAll: pushes that found the queue full and waited
+  Nanos back_pressure_time = 0;     // KeepAll: total time the producer waited
+  std::size_t high_water = 0;       // most frames ever waiting
 };
 
 class FrameQueue {

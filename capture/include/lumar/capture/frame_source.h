@@ -10,8 +10,8 @@
 namespace lumar::capture {
 
 struct Frame {
-  cv::Mat image;       // 8-bit BGR, as the camera delivered it (distorted, display-encoded)
-  Nanos time = 0;      // middle of the exposure; recordings: since the recording's start
+  cv::Mat image;           // 8-bit BGR, as the camera delivered it (distorted, display-encoded)
+  Nanos time = 0;          // middle of the exposure; recordings: since the recording's start
   std::int64_t index = 0;  // frame number at the source (gaps mean dropped frames)
 };
 

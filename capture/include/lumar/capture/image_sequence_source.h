@@ -18,9 +18,9 @@
 namespace lumar::capture {
 
 struct ImageSequenceSettings {
-  std::string pattern;                 // folder or glob
-  std::filesystem::path timestamps;    // CSV as above; empty: use fps
-  double fps = 0;                      // > 0 when there is no timestamp table
+  std::string pattern;               // folder or glob
+  std::filesystem::path timestamps;  // CSV as above; empty: use fps
+  double fps = 0;                    // > 0 when there is no timestamp table
 };
 
 class ImageSequenceSource final : public FrameSource {

@@ -48,8 +48,8 @@ struct RecordingSettings {
   std::string codec = "mjpeg";  // "mjpeg" (near-lossless, .avi) or "ffv1" (lossless, .mkv)
   int quality = 95;             // MJPEG quality 1..100; ignored by ffv1
   int frames_per_segment = 30;
-  double fps = 30;              // nominal, written into the container and session.json
-  cv::Size size;                // every frame must be BGR8 of this size
+  double fps = 30;  // nominal, written into the container and session.json
+  cv::Size size;    // every frame must be BGR8 of this size
 };
 
 // Throws InputError "<what>: ..." when a setting is out of range or the codec unknown.
@@ -60,7 +60,7 @@ struct FrameEntry {
   std::int64_t index = 0;  // frame number at the source (gaps are dropped frames)
   Nanos time = 0;          // since the start of the recording
   int segment = 0;
-  int segment_frame = 0;   // position within the segment, from 0
+  int segment_frame = 0;  // position within the segment, from 0
 };
 
 // One row of truth.csv.
@@ -71,10 +71,8 @@ struct TruthEntry {
 };
 
 // "video/segment-000012.avi" (or .mkv for ffv1) inside `dir`.
-std::filesystem::path segment_path(const std::filesystem::path& dir, const std::string& codec,
-                                   int segment);
+std::filesystem::path segment_path(const std::filesystem::path& dir, const std::string& codec, int segment);
 // The name a segment has while it is being written: "video/segment-000012.partial.avi".
-std::filesystem::path partial_segment_path(const std::filesystem::path& dir,
-                                           const std::string& codec, int segment);
+std::filesystem::path partial_segment_path(const std::filesystem::path& dir, const std::string& codec, int segment);
 
 }  // namespace lumar::capture

@@ -24,14 +24,14 @@ class RecordingReader {
   const std::filesystem::path& directory() const { return dir_; }
   const nlohmann::json& session() const { return session_; }
   const RecordingSettings& video() const { return video_; }  // from session.json "video"
-  bool complete() const;  // closed cleanly (false after a crash)
+  bool complete() const;                                     // closed cleanly (false after a crash)
   const std::vector<FrameEntry>& frames() const { return frames_; }
   std::filesystem::path segment_file(int segment) const;
 
   // Chunks up to the first torn or bad one; `ignored_bytes` gets the bytes after them.
   std::vector<tracking::ByteChunk> tracker_chunks(std::size_t* ignored_bytes = nullptr) const;
   std::vector<tracking::PoseSample> poses() const;
-  std::vector<TruthEntry> truth() const;  // empty when there is no truth.csv
+  std::vector<TruthEntry> truth() const;             // empty when there is no truth.csv
   std::unique_ptr<FrameSource> open_frames() const;  // a RecordingSource
 
  private:

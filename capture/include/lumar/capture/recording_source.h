@@ -33,10 +33,10 @@ class RecordingSource : public FrameSource {
   std::size_t next_ = 0;
 
   cv::VideoCapture capture_;
-  int segment_ = -1;              // the open segment
+  int segment_ = -1;  // the open segment
   std::filesystem::path segment_file_;
-  int segment_rows_ = 0;          // frames.csv rows for it
-  int decoded_ = 0;               // frames decoded from it so far
+  int segment_rows_ = 0;  // frames.csv rows for it
+  int decoded_ = 0;       // frames decoded from it so far
 };
 
 }  // namespace lumar::capture

@@ -13,9 +13,9 @@
 #include <memory>
 #include <nlohmann/json.hpp>
 
+#include "lumar/base/pose.h"
 #include "lumar/capture/frame_source.h"
 #include "lumar/capture/recording_format.h"
-#include "lumar/base/pose.h"
 #include "lumar/tracking/byte_chunk.h"
 #include "lumar/tracking/pose_sample.h"
 
@@ -27,8 +27,7 @@ class RecordingWriter {
   // `session` is the caller's JSON object (intrinsics, tracker settings, rig, ...);
   // the writer owns and overwrites its keys "format", "version", "complete",
   // "frames" and "video". Throws InputError for bad settings or a non-object session.
-  RecordingWriter(const std::filesystem::path& dir, nlohmann::json session,
-                  RecordingSettings settings);
+  RecordingWriter(const std::filesystem::path& dir, nlohmann::json session, RecordingSettings settings);
   ~RecordingWriter();  // closes if not closed; never throws (logs a failure)
   RecordingWriter(const RecordingWriter&) = delete;
   RecordingWriter& operator=(const RecordingWriter&) = delete;

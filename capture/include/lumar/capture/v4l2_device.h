@@ -35,16 +35,15 @@ int xioctl(V4l2Device& device, int fd, unsigned long request, void* arg);
 
 // What one /dev/videoN says about itself.
 struct V4l2DeviceInfo {
-  std::string path;             // "/dev/video0"
+  std::string path;  // "/dev/video0"
   std::string card, driver, bus;
-  bool video_capture = false;   // V4L2_CAP_VIDEO_CAPTURE (metadata nodes have not)
-  bool streaming = false;       // V4L2_CAP_STREAMING (mmap)
-  std::string problem;          // why it could not be opened or queried ("" = it could)
+  bool video_capture = false;  // V4L2_CAP_VIDEO_CAPTURE (metadata nodes have not)
+  bool streaming = false;      // V4L2_CAP_STREAMING (mmap)
+  std::string problem;         // why it could not be opened or queried ("" = it could)
 };
 
 // /dev/video* in `dev_dir` (numerically sorted), each opened and asked VIDIOC_QUERYCAP.
 // Never throws; a node that cannot be opened says why in `problem`.
-std::vector<V4l2DeviceInfo> list_v4l2_devices(V4l2Device& device,
-                                              const std::filesystem::path& dev_dir = "/dev");
+std::vector<V4l2DeviceInfo> list_v4l2_devices(V4l2Device& device, const std::filesystem::path& dev_dir = "/dev");
 
 }  // namespace lumar::capture

@@ -14,10 +14,10 @@
 #include <string>
 #include <vector>
 
-#include "lumar/capture/frame_source.h"
-#include "lumar/capture/v4l2_device.h"
 #include "lumar/base/error.h"
 #include "lumar/base/time.h"
+#include "lumar/capture/frame_source.h"
+#include "lumar/capture/v4l2_device.h"
 
 namespace lumar::capture {
 
@@ -29,11 +29,11 @@ struct CameraVanished : RuntimeError {
 struct V4l2Settings {
   std::string path = "/dev/video0";
   int width = 640, height = 480;  // asked for; the driver picks the nearest it has
-  double fps = 30;                 // asked for with VIDIOC_S_PARM where supported (0: leave)
+  double fps = 30;                // asked for with VIDIOC_S_PARM where supported (0: leave)
   // Pixel formats in order of preference, as fourcc strings.
   std::vector<std::string> formats{"YUYV", "MJPG", "BGR3", "RGB3"};
-  int buffers = 4;                 // mmap buffers requested (at least 4)
-  Nanos poll_timeout = 100'000'000;    // one poll(2) wait
+  int buffers = 4;                      // mmap buffers requested (at least 4)
+  Nanos poll_timeout = 100'000'000;     // one poll(2) wait
   Nanos frame_timeout = 2'000'000'000;  // no frame this long: RuntimeError (never hang)
   // Radiometry: lock auto-exposure (manual mode) where the camera offers it, and set
   // exposure (100 us units, V4L2_CID_EXPOSURE_ABSOLUTE) and gain when >= 0.
@@ -56,13 +56,13 @@ struct V4l2Stats {
 
 // What was negotiated with the camera.
 struct V4l2Format {
-  std::string fourcc;      // "YUYV"
+  std::string fourcc;  // "YUYV"
   int width = 0, height = 0;
   int bytes_per_line = 0;
-  double fps = 0;          // from VIDIOC_G_PARM (0 if the driver does not say)
-  int buffers = 0;         // mmap buffers granted
-  bool emulated = false;   // libv4l2 converts to this format in user space
-  std::vector<std::string> offered;  // every format the device listed
+  double fps = 0;                         // from VIDIOC_G_PARM (0 if the driver does not say)
+  int buffers = 0;                        // mmap buffers granted
+  bool emulated = false;                  // libv4l2 converts to this format in user space
+  std::vector<std::string> offered;       // every format the device listed
   std::vector<std::string> controls_set;  // "auto_exposure=manual", "exposure_absolute=100", ...
 };
 
@@ -107,7 +107,7 @@ class V4l2Source final : public FrameSource {
   bool streaming_ = false;
   V4l2Format format_;
   V4l2Stats stats_;
-  Nanos exposure_ = 0;          // known exposure time (0: unknown)
+  Nanos exposure_ = 0;             // known exposure time (0: unknown)
   std::int64_t index_offset_ = 0;  // Frame::index = sequence + index_offset_
   std::int64_t last_sequence_ = -1;
   Nanos last_time_ = 0;

@@ -45,7 +45,6 @@ bool box_outside(const ShadowCone& cone, const glm::vec3& lo, const glm::vec3& h
   return false;
 }
 
-
 }  // namespace
 
 ObjectShadows::ObjectShadows(const Emitters& emitters) : samples_(emitters.samples), distant_(emitters.distant) {
@@ -87,10 +86,10 @@ glm::vec3 ObjectShadows::unshadowed(const glm::vec3& x, const glm::vec3& n) cons
       const __m128 r2 = _mm_add_ps(_mm_add_ps(_mm_mul_ps(dx, dx), _mm_mul_ps(dy, dy)), _mm_mul_ps(dz, dz));
       // cos_x cos_e / max(r^2, cap) = (n.d)(-n_e.d) / (r^2 max(r^2, cap)): no square root.
       const __m128 along_n = _mm_add_ps(_mm_add_ps(_mm_mul_ps(nx, dx), _mm_mul_ps(ny, dy)), _mm_mul_ps(nz, dz));
-      const __m128 along_e = _mm_sub_ps(
-          zero, _mm_add_ps(_mm_add_ps(_mm_mul_ps(at(3), dx), _mm_mul_ps(at(4), dy)), _mm_mul_ps(at(5), dz)));
-      const __m128 ok = _mm_and_ps(_mm_and_ps(_mm_cmpgt_ps(along_n, zero), _mm_cmpgt_ps(along_e, zero)),
-                                   _mm_cmpgt_ps(r2, tiny));
+      const __m128 along_e =
+          _mm_sub_ps(zero, _mm_add_ps(_mm_add_ps(_mm_mul_ps(at(3), dx), _mm_mul_ps(at(4), dy)), _mm_mul_ps(at(5), dz)));
+      const __m128 ok =
+          _mm_and_ps(_mm_and_ps(_mm_cmpgt_ps(along_n, zero), _mm_cmpgt_ps(along_e, zero)), _mm_cmpgt_ps(r2, tiny));
       const __m128 q = _mm_div_ps(_mm_mul_ps(along_n, along_e), _mm_mul_ps(r2, _mm_max_ps(r2, cap)));
       w = _mm_and_ps(ok, q);
     }

@@ -42,8 +42,8 @@ std::array<glm::vec3, 8> bounding_box(const std::vector<glm::vec3>& points) {
   cv::Mat values, vectors;
   cv::eigen(cv::Mat(cov), values, vectors);
   glm::dvec3 axis[3];
-  for (int a = 0; a < 3; ++a) axis[a] = glm::normalize(glm::dvec3(vectors.at<double>(a, 0), vectors.at<double>(a, 1),
-                                                                  vectors.at<double>(a, 2)));
+  for (int a = 0; a < 3; ++a)
+    axis[a] = glm::normalize(glm::dvec3(vectors.at<double>(a, 0), vectors.at<double>(a, 1), vectors.at<double>(a, 2)));
   if (!(glm::length(axis[0]) > 0.5) || !(glm::length(axis[1]) > 0.5))  // degenerate: world axes
     axis[0] = {1, 0, 0}, axis[1] = {0, 1, 0};
   axis[1] = glm::normalize(axis[1] - glm::dot(axis[1], axis[0]) * axis[0]);
@@ -121,7 +121,8 @@ void record_blocker(const RTCFilterFunctionNArguments* args) {
 }
 
 void report_embree_error(void*, RTCError code, const char* message) {
-  if (code != RTC_ERROR_NONE) throw RuntimeError(std::string("Embree (shadow meshes): ") + (message ? message : "error"));
+  if (code != RTC_ERROR_NONE)
+    throw RuntimeError(std::string("Embree (shadow meshes): ") + (message ? message : "error"));
 }
 
 // The model-space BVHs live on their own device (RayScene keeps its device private).
@@ -149,7 +150,8 @@ OccluderMesh::OccluderMesh(const Mesh& model) {
     std::vector<std::pair<std::uint32_t, std::uint32_t>> keyed(model.triangle_count());
     for (std::uint32_t t = 0; t < model.triangle_count(); ++t) {
       const glm::vec3 c = (model.positions[model.indices[3 * t]] + model.positions[model.indices[3 * t + 1]] +
-                           model.positions[model.indices[3 * t + 2]]) / 3.0f;
+                           model.positions[model.indices[3 * t + 2]]) /
+                          3.0f;
       const glm::uvec3 q = glm::uvec3(glm::clamp((c - lo) * scale, glm::vec3(0.0f), glm::vec3(1023.0f)));
       std::uint32_t key = 0;
       for (int bit = 9; bit >= 0; --bit)
@@ -163,7 +165,7 @@ OccluderMesh::OccluderMesh(const Mesh& model) {
 
   RTCDevice device = bvh_device();
   RTCScene scene = rtcNewScene(device);
-  rtcSetSceneBuildQuality(scene, RTC_BUILD_QUALITY_HIGH);  // built once, traced every frame
+  rtcSetSceneBuildQuality(scene, RTC_BUILD_QUALITY_HIGH);           // built once, traced every frame
   rtcSetSceneFlags(scene, RTC_SCENE_FLAG_CONTEXT_FILTER_FUNCTION);  // record_blocker
   RTCGeometry geom = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
   rtcSetGeometryBuildQuality(geom, RTC_BUILD_QUALITY_HIGH);
@@ -231,7 +233,8 @@ bool OccluderMesh::occluded(const glm::vec3& origin, const glm::vec3& dir, float
   return r.tfar < 0.0f;
 }
 
-LUMAR_AVX2_CLONES bool OccluderMesh::blocked_near(const glm::vec3& o, const glm::vec3& d, float t_far, std::uint32_t& triangle) const {
+LUMAR_AVX2_CLONES bool OccluderMesh::blocked_near(const glm::vec3& o, const glm::vec3& d, float t_far,
+                                                  std::uint32_t& triangle) const {
   // Margins (barycentric, and along the segment) far above float error: a hit here is a
   // hit for Embree's watertight test too. Rays within ~0.06 degrees of a triangle's plane
   // are left to Embree.

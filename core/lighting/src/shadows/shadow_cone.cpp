@@ -10,7 +10,8 @@ ShadowCone::ShadowCone(const std::array<glm::vec3, 8>& corners, const glm::vec3&
   build(corners, emitter, distant);
 }
 
-LUMAR_AVX2_CLONES void ShadowCone::build(const std::array<glm::vec3, 8>& corners, const glm::vec3& emitter, bool distant) {
+LUMAR_AVX2_CLONES void ShadowCone::build(const std::array<glm::vec3, 8>& corners, const glm::vec3& emitter,
+                                         bool distant) {
   const glm::vec3 centre = 0.5f * (corners[0] + corners[7]);
   const glm::vec3 edge[3] = {corners[1] - corners[0], corners[2] - corners[0], corners[4] - corners[0]};
   // Which face of each axis pair faces the emitter: +1 the + face, -1 the - face, 0 neither

@@ -1,5 +1,5 @@
-#include "lumar/base/color.h"
 #include "lumar/lighting/shadows/shadow_emitters.h"
+#include "lumar/base/color.h"
 
 #include <algorithm>
 #include <cmath>
@@ -94,7 +94,8 @@ class Clustering {
       }
     }
     cut = std::clamp<std::size_t>(cut, 1, idx.size() - 1);
-    return {make({idx.begin(), idx.begin() + std::ptrdiff_t(cut)}), make({idx.begin() + std::ptrdiff_t(cut), idx.end()})};
+    return {make({idx.begin(), idx.begin() + std::ptrdiff_t(cut)}),
+            make({idx.begin() + std::ptrdiff_t(cut), idx.end()})};
   }
 
   // Splits until `done` says stop; `priority` picks the cluster to split next.
@@ -242,8 +243,7 @@ Emitters build_emitters(const EnvironmentMap& map, const RayScene& proxy, bool d
         [&](const auto& cs) { return int(cs.size()) >= options.fixed_patches; });
   } else {
     patches = clustering.run(
-        all,
-        [&](const auto& c) { return c.angular_radius > resolved_angle ? c.importance * c.angular_radius : 0.0; },
+        all, [&](const auto& c) { return c.angular_radius > resolved_angle ? c.importance * c.angular_radius : 0.0; },
         [&](const auto& cs) {
           return int(cs.size()) >= options.max_patches || resolved_share(cs) >= options.resolved_fraction;
         });

@@ -149,7 +149,10 @@ ShadowScene::ShadowScene(const Scene& scene) : regions_(scene.shadows) {
 
 ShadowScene::ShadowScene(EnvironmentMap map, bool distant, Mesh room_world, std::vector<Object> objects,
                          ShadowRegions regions)
-    : map_(std::move(map)), distant_(distant), room_(std::move(room_world)), objects_(std::move(objects)),
+    : map_(std::move(map)),
+      distant_(distant),
+      room_(std::move(room_world)),
+      objects_(std::move(objects)),
       regions_(std::move(regions)) {
   proxy_ = std::make_unique<RayScene>();
   if (room_.triangle_count() > 0) proxy_->add_static(room_);

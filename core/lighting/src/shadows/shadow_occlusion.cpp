@@ -131,15 +131,20 @@ template <class F>
     const float a = fp.a[k], b = fp.b[k], c = fp.c[k];
     // The rows: the half-plane over the grid's whole u range bounds v.
     const float amin = std::min(a * u_lo, a * u_hi);
-    if (b > 0.0f) v_hi = std::min(v_hi, (-c - amin) / b);
-    else if (b < 0.0f) v_lo = std::max(v_lo, (-c - amin) / b);
-    else if (amin + c > 0.0f) return 0;
+    if (b > 0.0f)
+      v_hi = std::min(v_hi, (-c - amin) / b);
+    else if (b < 0.0f)
+      v_lo = std::max(v_lo, (-c - amin) / b);
+    else if (amin + c > 0.0f)
+      return 0;
     if (a == 0.0f) continue;  // bounds v only: done above
     // Row j spans v0 + [j, j + 1] cell; the smallest b v over it is at its low end for b > 0.
     const float v_at = g.v0 + (b < 0.0f ? g.cell : 0.0f);
     const float alpha = (-c - b * v_at) / a, beta = -b * g.cell / a;
-    if (a > 0.0f) up_alpha[ups] = alpha, up_beta[ups++] = beta;
-    else down_alpha[downs] = alpha, down_beta[downs++] = beta;
+    if (a > 0.0f)
+      up_alpha[ups] = alpha, up_beta[ups++] = beta;
+    else
+      down_alpha[downs] = alpha, down_beta[downs++] = beta;
   }
   if (!(v_lo <= v_hi)) return 0;
   const int j0 = std::clamp(int(std::floor((v_lo - g.v0) / g.cell)), 0, g.nv - 1);
@@ -238,7 +243,7 @@ void LineShadows::trace(Object& o) {
   // After a jump, a walk would fail at every line and only add to Embree's cost.
   if (!OccluderMesh::within_walk_reach(o.mesh->whole(), o.T_world_model, o.T_blocked)) o.blocked.clear();
   o.T_blocked = o.T_world_model;
-  auto last = o.blocked.begin();  // both lists ascend by line: a merge
+  auto last = o.blocked.begin();        // both lists ascend by line: a merge
   constexpr std::ptrdiff_t kAhead = 8;  // blockers prefetched this many entries ahead
   std::size_t near = 0;
   for (const Candidate& c : candidates_) {
@@ -247,7 +252,8 @@ void LineShadows::trace(Object& o) {
     const glm::vec3 d = lines_.distant ? s : s - p;
     while (last != o.blocked.end() && last->line < c.line) ++last;
     if (o.blocked.end() - last > kAhead) o.mesh->prefetch(last[kAhead].triangle);
-    std::uint32_t triangle = last != o.blocked.end() && last->line == c.line ? last->triangle : OccluderMesh::kNoTriangle;
+    std::uint32_t triangle =
+        last != o.blocked.end() && last->line == c.line ? last->triangle : OccluderMesh::kNoTriangle;
     bool blocked = o.mesh->blocked_near(p, d, t_far, triangle);
     near += blocked;
     if (!blocked) blocked = o.mesh->occluded(p, d, t_far, &triangle);
@@ -312,7 +318,8 @@ bool LineShadows::update() {
     const glm::mat3 R(o.T_model_world);
     for (std::size_t k = 0; k < lines_.samples.size(); ++k) {
       const glm::vec3& x = lines_.samples[k].position;
-      o.sample_model[k] = lines_.distant ? kDistantLineLength * (R * x) : glm::vec3(o.T_model_world * glm::vec4(x, 1.0f));
+      o.sample_model[k] =
+          lines_.distant ? kDistantLineLength * (R * x) : glm::vec3(o.T_model_world * glm::vec4(x, 1.0f));
     }
     if (!culling_) {
       trace_all(o);

@@ -63,8 +63,8 @@ Frame frame_of(const std::vector<glm::vec3>& points, const std::vector<glm::vec3
   return f;
 }
 
-void add_grid(const std::vector<glm::vec3>& points, const std::vector<std::uint32_t>& idx, std::size_t b,
-              std::size_t e, const Frame& f, ReceiverGrids& out) {
+void add_grid(const std::vector<glm::vec3>& points, const std::vector<std::uint32_t>& idx, std::size_t b, std::size_t e,
+              const Frame& f, ReceiverGrids& out) {
   ReceiverGrid g;
   g.origin = glm::vec3(f.mean);
   g.u_axis = glm::vec3(f.axis[0]), g.v_axis = glm::vec3(f.axis[1]), g.normal = glm::vec3(f.axis[2]);
@@ -109,9 +109,9 @@ void split(const std::vector<glm::vec3>& points, const std::vector<glm::vec3>& n
   }
   // Across the normal, at the middle of the range: separates a table top from the floor.
   const double mid = 0.5 * (f.lo.z + f.hi.z);
-  const auto it = std::partition(idx.begin() + std::ptrdiff_t(b), idx.begin() + std::ptrdiff_t(e), [&](std::uint32_t k) {
-    return glm::dot(glm::dvec3(points[k]) - f.mean, f.axis[2]) < mid;
-  });
+  const auto it =
+      std::partition(idx.begin() + std::ptrdiff_t(b), idx.begin() + std::ptrdiff_t(e),
+                     [&](std::uint32_t k) { return glm::dot(glm::dvec3(points[k]) - f.mean, f.axis[2]) < mid; });
   const auto m = std::size_t(it - idx.begin());
   if (m == b || m == e) {  // cannot happen for distinct heights; keep the group whole
     add_grid(points, idx, b, e, f, out);

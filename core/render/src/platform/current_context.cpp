@@ -4,8 +4,6 @@
 
 namespace lumar::gl {
 
-bool any_context_current() {
-  return eglGetCurrentContext() != EGL_NO_CONTEXT || glXGetCurrentContext() != nullptr;
-}
+bool any_context_current() { return eglGetCurrentContext() != EGL_NO_CONTEXT || glXGetCurrentContext() != nullptr; }
 
 }  // namespace lumar::gl

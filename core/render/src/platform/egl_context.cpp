@@ -14,9 +14,7 @@
 namespace lumar::gl {
 namespace {
 
-bool has_token(const char* list, const char* token) {
-  return list && epoxy_extension_in_string(list, token);
-}
+bool has_token(const char* list, const char* token) { return list && epoxy_extension_in_string(list, token); }
 
 std::string egl_error_text() { return cv::format("EGL error 0x%04x", eglGetError()); }
 
@@ -69,18 +67,16 @@ class HeadlessContext : public Context {
     if (!has_token(extensions, "EGL_KHR_surfaceless_context"))
       throw RuntimeError("OpenGL: the EGL display lacks EGL_KHR_surfaceless_context; update Mesa");
     // Surfaceless displays offer pbuffer configs only, so ask for those, not windows.
-    const EGLint config_attributes[] = {EGL_SURFACE_TYPE, EGL_PBUFFER_BIT, EGL_RENDERABLE_TYPE,
-                                        EGL_OPENGL_BIT, EGL_NONE};
+    const EGLint config_attributes[] = {EGL_SURFACE_TYPE, EGL_PBUFFER_BIT, EGL_RENDERABLE_TYPE, EGL_OPENGL_BIT,
+                                        EGL_NONE};
     EGLConfig config = nullptr;
     EGLint count = 0;
     if (!eglChooseConfig(display_, config_attributes, &config, 1, &count) || count < 1)
-      throw RuntimeError("OpenGL: EGL offers no desktop-OpenGL config on the surfaceless display (" +
-                         egl_error_text() + "); install Mesa's OpenGL driver");
-    const EGLint context_attributes[] = {EGL_CONTEXT_MAJOR_VERSION, 4,
-                                         EGL_CONTEXT_MINOR_VERSION, 5,
-                                         EGL_CONTEXT_OPENGL_PROFILE_MASK,
-                                         EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT,
-                                         EGL_NONE};
+      throw RuntimeError("OpenGL: EGL offers no desktop-OpenGL config on the surfaceless display (" + egl_error_text() +
+                         "); install Mesa's OpenGL driver");
+    const EGLint context_attributes[] = {
+        EGL_CONTEXT_MAJOR_VERSION,           4,       EGL_CONTEXT_MINOR_VERSION, 5, EGL_CONTEXT_OPENGL_PROFILE_MASK,
+        EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT, EGL_NONE};
     context_ = eglCreateContext(display_, config, EGL_NO_CONTEXT, context_attributes);
     if (context_ == EGL_NO_CONTEXT)
       throw RuntimeError("OpenGL: cannot create an OpenGL 4.5 core context with EGL (" + egl_error_text() +
@@ -95,8 +91,7 @@ class HeadlessContext : public Context {
 
   void destroy() {
     if (context_ != EGL_NO_CONTEXT) {
-      if (eglGetCurrentContext() == context_)
-        eglMakeCurrent(display_, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
+      if (eglGetCurrentContext() == context_) eglMakeCurrent(display_, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
       eglDestroyContext(display_, context_);
       context_ = EGL_NO_CONTEXT;
     }

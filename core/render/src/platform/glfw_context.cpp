@@ -8,9 +8,9 @@
 #include <string>
 
 #include "gl_util.h"
-#include "platform/x11_window_image.h"
 #include "lumar/base/error.h"
 #include "lumar/render/platform/context.h"
+#include "platform/x11_window_image.h"
 
 namespace lumar::gl {
 namespace {
@@ -40,13 +40,12 @@ void initialise_glfw() {
 struct WindowContext::Impl {
   GLFWwindow* window = nullptr;
   std::string name;
-  GlName image;       // the last presented image, as a texture
-  GlName image_fbo;   // reads `image` for the blit
+  GlName image;      // the last presented image, as a texture
+  GlName image_fbo;  // reads `image` for the blit
   int image_width = 0, image_height = 0;
 };
 
-WindowContext::WindowContext(int width, int height, const std::string& title)
-    : impl_(std::make_unique<Impl>()) {
+WindowContext::WindowContext(int width, int height, const std::string& title) : impl_(std::make_unique<Impl>()) {
   if (width <= 0 || height <= 0)
     throw InputError("OpenGL window: size " + std::to_string(width) + "x" + std::to_string(height) +
                      " is not positive; give a real window size");

@@ -38,10 +38,9 @@ cv::Mat read_x11_window_image(GLFWwindow* window) {
     throw RuntimeError("OpenGL window: not an X11 window, cannot read what it shows; run under X11");
   XWindowAttributes attributes{};
   XGetWindowAttributes(display, x_window, &attributes);
-  XImage* image = XGetImage(display, x_window, 0, 0, unsigned(attributes.width), unsigned(attributes.height),
-                            AllPlanes, ZPixmap);
-  if (!image)
-    throw RuntimeError("OpenGL window: XGetImage failed (is the window mapped and on screen?)");
+  XImage* image =
+      XGetImage(display, x_window, 0, 0, unsigned(attributes.width), unsigned(attributes.height), AllPlanes, ZPixmap);
+  if (!image) throw RuntimeError("OpenGL window: XGetImage failed (is the window mapped and on screen?)");
   cv::Mat out(attributes.height, attributes.width, CV_8UC3);
   for (int r = 0; r < out.rows; ++r)
     for (int c = 0; c < out.cols; ++c) {

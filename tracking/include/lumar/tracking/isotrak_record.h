@@ -22,8 +22,8 @@ enum OutputItem : int {
 };
 
 struct IsotrakRecord {
-  int station = 1;     // 1-based station number
-  char status = ' ';   // ' ', or an error letter; '@' / '*' for a stylus button
+  int station = 1;                         // 1-based station number
+  char status = ' ';                       // ' ', or an error letter; '@' / '*' for a stylus button
   std::optional<glm::dvec3> position;      // device units: inches, or cm after `u`
   std::optional<glm::dvec3> attitude_deg;  // azimuth, elevation, roll
   std::optional<glm::dquat> quaternion;    // as sent (4 decimals), w first on the wire

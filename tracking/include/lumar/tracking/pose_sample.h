@@ -7,8 +7,8 @@
 namespace lumar::tracking {
 
 struct PoseSample {
-  Nanos time = 0;    // when the sensor was at this pose (device latency already removed)
-  int station = 1;   // Polhemus station number, 1-based
+  Nanos time = 0;   // when the sensor was at this pose (device latency already removed)
+  int station = 1;  // Polhemus station number, 1-based
   Pose T_transmitter_sensor;
 };
 

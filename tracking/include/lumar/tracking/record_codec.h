@@ -51,9 +51,9 @@ std::vector<int> parse_output_list(const std::string& text);
 
 struct TrackerFormat {
   Device device = Device::Isotrak2;
-  bool binary = false;          // `f` (binary) instead of `F` (ASCII)
-  OutputFormat output;          // output list and position unit
-  int max_station = 2;          // stations accepted by the decoder: station_count(device)
+  bool binary = false;                  // `f` (binary) instead of `F` (ASCII)
+  OutputFormat output;                  // output list and position unit
+  int max_station = 2;                  // stations accepted by the decoder: station_count(device)
   double euler_full_scale_deg = 180.0;  // ISOTRAK II binary: degrees at int16 +32767 (unverified)
 
   // The format with max_station set for the device.

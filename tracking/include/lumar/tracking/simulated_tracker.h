@@ -19,18 +19,18 @@ namespace lumar::tracking {
 struct SimulatedTrackerSettings {
   double rate_hz = 60.0;
   int baud = 115200;
-  Nanos device_latency = 20'000'000;     // 20 ms from measurement to first byte on the wire
-  double orientation_noise_deg = 0.75;   // RMS angle of the rotation error
-  double position_noise_m = 0.0025;      // RMS per axis
+  Nanos device_latency = 20'000'000;    // 20 ms from measurement to first byte on the wire
+  double orientation_noise_deg = 0.75;  // RMS angle of the rotation error
+  double position_noise_m = 0.0025;     // RMS per axis
   OutputFormat format;
   std::uint64_t seed = 1;
   int station = 1;
 };
 
 struct SimulatedTrackerOutput {
-  std::vector<ByteChunk> chunks;            // one whole record per chunk
-  std::vector<PoseSample> noisy_samples;    // what the device measured (before
-                                            // quantisation), time = true measurement time
+  std::vector<ByteChunk> chunks;          // one whole record per chunk
+  std::vector<PoseSample> noisy_samples;  // what the device measured (before
+                                          // quantisation), time = true measurement time
 };
 
 // true_pose(t) gives T_transmitter_sensor at time t, for t in [0, duration].

@@ -46,17 +46,17 @@ struct DriverSettings {
   std::vector<int> stations{1};  // Fastrak: one O command each (ISOTRAK II has one list)
   bool continuous = true;        // false: poll with P
   double poll_rate_hz = 30;
-  Nanos device_latency = 0;      // measurement to first byte, subtracted from sample times
-  Nanos watchdog = 2'000'000'000;          // no valid record this long is a fault
-  Nanos read_timeout = 20'000'000;         // longest single wait of the reader thread
-  Nanos write_timeout = 200'000'000;       // longest wait for room to send a command
-  Nanos command_gap = 20'000'000;          // pause after each configuration command
-  Nanos quiet_time = 100'000'000;          // no byte this long after "c": the device stopped
-  Nanos quiet_limit = 1'000'000'000;       // give up waiting for quiet after this
-  Nanos status_timeout = 1'000'000'000;    // "S" must be answered within this
-  Nanos reinit_wait = 8'000'000'000;       // silence after Ctrl-Y before talking again
-  Nanos reopen_interval = 250'000'000;     // between attempts to open a vanished port
-  std::size_t queue_capacity = 4096;       // samples waiting for take_samples()
+  Nanos device_latency = 0;              // measurement to first byte, subtracted from sample times
+  Nanos watchdog = 2'000'000'000;        // no valid record this long is a fault
+  Nanos read_timeout = 20'000'000;       // longest single wait of the reader thread
+  Nanos write_timeout = 200'000'000;     // longest wait for room to send a command
+  Nanos command_gap = 20'000'000;        // pause after each configuration command
+  Nanos quiet_time = 100'000'000;        // no byte this long after "c": the device stopped
+  Nanos quiet_limit = 1'000'000'000;     // give up waiting for quiet after this
+  Nanos status_timeout = 1'000'000'000;  // "S" must be answered within this
+  Nanos reinit_wait = 8'000'000'000;     // silence after Ctrl-Y before talking again
+  Nanos reopen_interval = 250'000'000;   // between attempts to open a vanished port
+  std::size_t queue_capacity = 4096;     // samples waiting for take_samples()
 };
 
 // Throws InputError for unusable settings (format, stations, non-positive times).
@@ -73,9 +73,9 @@ struct DriverStatus {
   std::uint64_t samples_dropped = 0;  // the queue was full (take_samples not called)
   std::uint64_t connects = 0;         // times valid records started arriving
   std::uint64_t watchdog_faults = 0;
-  std::uint64_t reset_attempts = 0;   // resets that did not end with a status record
-  std::uint64_t vanished = 0;         // times the port went away or could not be opened
-  Nanos last_record = 0;              // CLOCK_MONOTONIC of the last valid record's arrival (0: none)
+  std::uint64_t reset_attempts = 0;  // resets that did not end with a status record
+  std::uint64_t vanished = 0;        // times the port went away or could not be opened
+  Nanos last_record = 0;             // CLOCK_MONOTONIC of the last valid record's arrival (0: none)
 };
 
 class TrackerDriver {

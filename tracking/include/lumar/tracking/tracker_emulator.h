@@ -40,9 +40,9 @@
 namespace lumar::tracking {
 
 struct EmulatorFaults {
-  double garbage_rate = 0;     // fraction of record bytes replaced by a different random byte
-  double drop_rate = 0;        // fraction of records never sent (the line stays idle)
-  Nanos silence_every = 0;     // > 0: hang (see silence_for()) for silence_for, every silence_every
+  double garbage_rate = 0;  // fraction of record bytes replaced by a different random byte
+  double drop_rate = 0;     // fraction of records never sent (the line stays idle)
+  Nanos silence_every = 0;  // > 0: hang (see silence_for()) for silence_for, every silence_every
   Nanos silence_for = 0;
   Nanos disconnect_every = 0;  // > 0: the pty vanishes for disconnect_for, every disconnect_every
   Nanos disconnect_for = 0;
@@ -50,49 +50,49 @@ struct EmulatorFaults {
 
 struct EmulatorSettings {
   Device device = Device::Isotrak2;
-  int baud = 115200;                   // only paces the output; a pty has no real baud
-  double rate_hz = 0;                  // records/s over all active stations; 0 = 60 (ISOTRAK II), 120 (Fastrak)
-  std::vector<int> stations{1};        // active at power-up
+  int baud = 115200;             // only paces the output; a pty has no real baud
+  double rate_hz = 0;            // records/s over all active stations; 0 = 60 (ISOTRAK II), 120 (Fastrak)
+  std::vector<int> stations{1};  // active at power-up
   bool continuous_at_power_up = false;
-  Nanos device_latency = 20'000'000;   // measurement to first byte on the wire
-  double orientation_noise_deg = 0.75; // RMS
-  double position_noise_m = 0.0025;    // RMS per axis
-  std::uint64_t seed = 1;              // noise and faults
-  double euler_full_scale_deg = 180.0; // ISOTRAK II binary Euler scale (unverified)
+  Nanos device_latency = 20'000'000;     // measurement to first byte on the wire
+  double orientation_noise_deg = 0.75;   // RMS
+  double position_noise_m = 0.0025;      // RMS per axis
+  std::uint64_t seed = 1;                // noise and faults
+  double euler_full_scale_deg = 180.0;   // ISOTRAK II binary Euler scale (unverified)
   Nanos reinit_silence = 3'000'000'000;  // how long Ctrl-Y keeps the device silent
-  Trajectory trajectory;               // empty: builtin_trajectory("sweep")
-  std::filesystem::path link;          // also make this symlink to the pty ("" = none)
+  Trajectory trajectory;                 // empty: builtin_trajectory("sweep")
+  std::filesystem::path link;            // also make this symlink to the pty ("" = none)
   EmulatorFaults faults;
 };
 
 // One record the device produced, reported once its last byte was written to the pty
 // (or it was dropped, or the line was cut before it was out).
 struct SentRecord {
-  std::uint64_t sequence = 0;  // 0, 1, 2, ... over all records produced
-  Nanos measured = 0;          // CLOCK_MONOTONIC of the measurement
-  Nanos first_byte_due = 0;    // when its first byte was written to the pty
-  TrackerFormat format;        // what the record was encoded as
-  IsotrakRecord values;        // the values handed to the encoder (before quantisation)
+  std::uint64_t sequence = 0;       // 0, 1, 2, ... over all records produced
+  Nanos measured = 0;               // CLOCK_MONOTONIC of the measurement
+  Nanos first_byte_due = 0;         // when its first byte was written to the pty
+  TrackerFormat format;             // what the record was encoded as
+  IsotrakRecord values;             // the values handed to the encoder (before quantisation)
   std::vector<std::uint8_t> bytes;  // the encoded record, before any garbage
-  bool dropped = false;        // never sent
-  bool cut_short = false;      // not all of its bytes reached the pty (Ctrl-Y, disconnection,
-                               // a full pty, the emulator stopped)
-  int garbage_bytes = 0;       // how many of its bytes were replaced by garbage
+  bool dropped = false;             // never sent
+  bool cut_short = false;           // not all of its bytes reached the pty (Ctrl-Y, disconnection,
+                                    // a full pty, the emulator stopped)
+  int garbage_bytes = 0;            // how many of its bytes were replaced by garbage
 };
 
 struct EmulatorCounters {
-  std::uint64_t records_sent = 0;     // including damaged and cut-short ones
+  std::uint64_t records_sent = 0;  // including damaged and cut-short ones
   std::uint64_t records_cut_short = 0;
   std::uint64_t records_dropped = 0;
   std::uint64_t records_damaged = 0;  // sent with at least one garbage byte
   std::uint64_t garbage_bytes = 0;
-  std::uint64_t bytes_written = 0;    // to the pty
-  std::uint64_t bytes_lost = 0;       // the pty was full (nobody reading)
-  std::uint64_t commands = 0;         // commands recognised
+  std::uint64_t bytes_written = 0;  // to the pty
+  std::uint64_t bytes_lost = 0;     // the pty was full (nobody reading)
+  std::uint64_t commands = 0;       // commands recognised
   std::uint64_t status_replies = 0;
-  std::uint64_t reinits = 0;          // Ctrl-Y
+  std::uint64_t reinits = 0;  // Ctrl-Y
   std::uint64_t disconnects = 0;
-  std::uint64_t unencodable = 0;      // poses outside the format's range (not sent)
+  std::uint64_t unencodable = 0;  // poses outside the format's range (not sent)
 };
 
 class TrackerEmulator {

@@ -21,10 +21,10 @@
 namespace lumar::app {
 
 struct ImagesInputOptions {
-  std::string images;               // folder or glob
-  std::string poses;                // the CSV above
-  std::string camera;               // calibration (OpenCV YAML) of the camera that took them
-  std::string response;             // lumar-camera-response JSON (empty: sRGB)
+  std::string images;    // folder or glob
+  std::string poses;     // the CSV above
+  std::string camera;    // calibration (OpenCV YAML) of the camera that took them
+  std::string response;  // lumar-camera-response JSON (empty: sRGB)
   double vignetting_a = 0, vignetting_b = 0;
   double tracker_noise_deg = 0.75;  // how far the poses' rotations may be off (the refinement's prior)
 };

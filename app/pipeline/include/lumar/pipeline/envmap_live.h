@@ -22,10 +22,10 @@
 namespace lumar::app {
 
 struct LiveEnvmapOptions {
-  LiveInputOptions in;        // source, tracker, camera calibration (in.camera_file)
-  EnvmapOutputOptions out;    // out, width, coverage, preview, no_fill, azimuth offset
-  std::string rig;            // a session.json whose "rig" to use (default: identity, in.latency_ms)
-  std::string response;       // camera response JSON (default: sRGB; a recording: its own)
+  LiveInputOptions in;      // source, tracker, camera calibration (in.camera_file)
+  EnvmapOutputOptions out;  // out, width, coverage, preview, no_fill, azimuth offset
+  std::string rig;          // a session.json whose "rig" to use (default: identity, in.latency_ms)
+  std::string response;     // camera response JSON (default: sRGB; a recording: its own)
   double vignetting_a = 0, vignetting_b = 0;
   // Video linear value per unit radiance; a list is cycled over the frames (frame k, by
   // its source index, uses entry k mod n), e.g. a camera bracketing. A recording: its own.
@@ -34,9 +34,9 @@ struct LiveEnvmapOptions {
   double duration_s = 0;      // stop after this long (0: at the end of the source or Ctrl-C)
   double max_wait_ms = 100;   // longest a frame waits for the tracker to cover its time
   bool refine_at_end = false;
-  int keep_frames = 600;          // --refine-at-end: frames kept in memory (~0.9 MB each at 640x480)
+  int keep_frames = 600;            // --refine-at-end: frames kept in memory (~0.9 MB each at 640x480)
   double tracker_noise_deg = 0.75;  // --refine-at-end: the refinement's prior
-  double tracker_timeout_s = 10;  // the tracker's first pose must come within this (capture starts then)
+  double tracker_timeout_s = 10;    // the tracker's first pose must come within this (capture starts then)
 };
 
 // The live options that do not clash with the file inputs' (--width is the map's, so

@@ -31,19 +31,19 @@ void check_map_width(int width);
 
 // A sweep, ready to stitch. Frames are read on demand (twice with refinement), in order.
 struct SweepInput {
-  std::string name;                       // for messages: the recording or the image folder
-  calib::StitchSettings stitch;           // camera, response, vignetting, capture point, azimuth, width
-  std::vector<glm::dquat> rotations;      // tracked R_world_camera per frame
-  std::vector<double> exposures;          // video linear value per unit radiance, per frame
-  std::vector<int> groups;                // frames taken standing still share a group (empty: none)
-  std::vector<std::string> labels;        // per frame, the first columns of --corrections rows
-  std::string label_header = "frame";     // their header
+  std::string name;                              // for messages: the recording or the image folder
+  calib::StitchSettings stitch;                  // camera, response, vignetting, capture point, azimuth, width
+  std::vector<glm::dquat> rotations;             // tracked R_world_camera per frame
+  std::vector<double> exposures;                 // video linear value per unit radiance, per frame
+  std::vector<int> groups;                       // frames taken standing still share a group (empty: none)
+  std::vector<std::string> labels;               // per frame, the first columns of --corrections rows
+  std::string label_header = "frame";            // their header
   std::vector<std::optional<glm::dquat>> truth;  // true rotations when known (synthetic), else empty
-  double tracker_noise_deg = 0.75;        // the refinement's prior
+  double tracker_noise_deg = 0.75;               // the refinement's prior
   // Calls use(image, k) for k = 0, 1, ... n-1 (CV_8UC3 BGR, the camera's size); throws
   // InputError when a frame cannot be read.
   std::function<void(const std::function<void(const cv::Mat&, int)>& use)> read_frames;
-  std::string default_reference;          // reference map to compare with when --reference is not given
+  std::string default_reference;  // reference map to compare with when --reference is not given
 };
 
 // Refines, stitches, fills and writes every output asked for.

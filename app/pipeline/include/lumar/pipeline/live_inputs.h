@@ -7,32 +7,33 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
-#include "lumar/capture/frame_source.h"
 #include "lumar/base/camera.h"
+#include "lumar/capture/frame_source.h"
 #include "lumar/tracking/rig.h"
 #include "lumar/tracking/tracker_driver.h"
 
 namespace lumar::app {
 
 struct LiveInputOptions {
-  std::string source;            // video:FILE | images:DIR_OR_GLOB | v4l2:/dev/videoN | recording:DIR
-  std::string timestamps;        // images: file,time_ns table
-  double images_fps = 0;         // images: fixed rate
-  int width = 640, height = 480; // v4l2
-  double camera_fps = 30;        // v4l2
-  std::string pixel_format;      // v4l2: YUYV, MJPG (empty: YUYV, then MJPG, then libv4l2's BGR)
+  std::string source;             // video:FILE | images:DIR_OR_GLOB | v4l2:/dev/videoN | recording:DIR
+  std::string timestamps;         // images: file,time_ns table
+  double images_fps = 0;          // images: fixed rate
+  int width = 640, height = 480;  // v4l2
+  double camera_fps = 30;         // v4l2
+  std::string pixel_format;       // v4l2: YUYV, MJPG (empty: YUYV, then MJPG, then libv4l2's BGR)
   int exposure_100us = -1, gain = -1;
-  bool auto_exposure = false;    // v4l2: leave auto exposure on
-  std::string tracker;           // serial:/dev/ttyUSB0 (empty: no tracker)
+  bool auto_exposure = false;  // v4l2: leave auto exposure on
+  std::string tracker;         // serial:/dev/ttyUSB0 (empty: no tracker)
   std::string tracker_model = "isotrak2";
   int baud = 115200;
-  double latency_ms = 0;         // device latency, subtracted from pose times
-  std::string camera_file;       // OpenCV YAML intrinsics (empty: nominal pinhole)
+  double latency_ms = 0;    // device latency, subtracted from pose times
+  std::string camera_file;  // OpenCV YAML intrinsics (empty: nominal pinhole)
 };
 
 // The options of LiveInputOptions except the source, with the same names in every command.
-void add_live_input_options(CLI::App* cmd, LiveInputOptions& o,
-                            const std::string& camera_help = "Camera calibration (OpenCV YAML); default: a nominal pinhole");
+void add_live_input_options(
+    CLI::App* cmd, LiveInputOptions& o,
+    const std::string& camera_help = "Camera calibration (OpenCV YAML); default: a nominal pinhole");
 
 struct LiveSource {
   std::unique_ptr<capture::FrameSource> source;  // CLOCK_MONOTONIC times (files are played in real time)

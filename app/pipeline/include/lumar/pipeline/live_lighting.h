@@ -3,15 +3,15 @@
 // current"): every few frames, the undistorted, linearised video is compared with what
 // the map predicts for the same view (the proxy room textured from the map's capture
 // point), and the virtual objects' lighting is scaled by the smoothed global ratio.
-#include <optional>
 #include <opencv2/core.hpp>
+#include <optional>
 
+#include "lumar/base/pose.h"
 #include "lumar/calib/camera_response.h"
 #include "lumar/calib/lighting_adapter.h"
 #include "lumar/calib/undistortion.h"
 #include "lumar/capture/session.h"
 #include "lumar/render/renderer.h"
-#include "lumar/base/pose.h"
 
 namespace lumar::app {
 

@@ -12,10 +12,10 @@ namespace lumar::app {
 struct LiveOverlayOptions {
   LiveInputOptions in;
   std::filesystem::path scene;
-  std::filesystem::path rig;   // a session.json whose "rig" to use (default: identity, in.latency_ms)
-  double exposure = 1.0;       // video linear value per unit radiance
-  double max_wait_ms = 40;     // longest a frame waits for the tracker to cover its time
-  int max_frames = 0;          // 0: until the window closes, the source ends or Ctrl-C
+  std::filesystem::path rig;  // a session.json whose "rig" to use (default: identity, in.latency_ms)
+  double exposure = 1.0;      // video linear value per unit radiance
+  double max_wait_ms = 40;    // longest a frame waits for the tracker to cover its time
+  int max_frames = 0;         // 0: until the window closes, the source ends or Ctrl-C
 };
 
 // Runs until the window is closed, the source ends, Ctrl-C, or max_frames. Throws

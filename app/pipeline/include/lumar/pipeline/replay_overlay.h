@@ -6,9 +6,9 @@
 #include <memory>
 #include <optional>
 
-#include "lumar/pipeline/live_lighting.h"
 #include "lumar/calib/undistortion.h"
 #include "lumar/capture/recording_replay.h"
+#include "lumar/pipeline/live_lighting.h"
 #include "lumar/render/compositor.h"
 #include "lumar/render/platform/context.h"
 #include "lumar/scene/scene.h"
@@ -18,15 +18,16 @@ namespace lumar::app {
 enum class PoseSource { Tracker, Truth };
 
 struct StageTimes {  // milliseconds, summed over frames
-  double decode = 0, pose = 0, lighting = 0, upload = 0, background = 0, depth = 0, objects = 0, readback = 0, output = 0;
+  double decode = 0, pose = 0, lighting = 0, upload = 0, background = 0, depth = 0, objects = 0, readback = 0,
+         output = 0;
   int frames = 0;
 };
 
 struct OverlayFrame {
   std::int64_t index = 0;
   Nanos time = 0;
-  cv::Mat video;                  // as recorded
-  cv::Mat composite;              // BGR8 output
+  cv::Mat video;                       // as recorded
+  cv::Mat composite;                   // BGR8 output
   std::optional<Pose> T_world_camera;  // the pose used (nullopt: no pose, video only)
   double lighting_scale = 1.0;         // the map's light as the room measured now (1: unchanged)
 };
@@ -37,9 +38,8 @@ class ReplayOverlay {
   // `undistortion`: which undistorted camera the output uses (calib/undistortion.h).
   // `adapt_lighting_every` > 0: compare the video with the map every that many frames and
   // scale the objects' lighting as the room gets brighter or darker (live_lighting.h).
-  ReplayOverlay(const std::filesystem::path& recording, const std::filesystem::path& scene_override,
-                PoseSource poses, bool window,
-                calib::UndistortedCamera undistortion = calib::UndistortedCamera::SameMatrix,
+  ReplayOverlay(const std::filesystem::path& recording, const std::filesystem::path& scene_override, PoseSource poses,
+                bool window, calib::UndistortedCamera undistortion = calib::UndistortedCamera::SameMatrix,
                 int adapt_lighting_every = 0);
   ~ReplayOverlay();
 

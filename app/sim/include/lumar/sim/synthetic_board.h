@@ -17,16 +17,16 @@ namespace lumar::app {
 
 struct BoardSynthSettings {
   std::filesystem::path out;
-  CameraIntrinsics camera;           // calibrated, with distortion
-  cv::Size board{9, 6};              // inner corners
-  double square = 0.025;             // metres
-  double seconds = 10.0;             // of video
+  CameraIntrinsics camera;  // calibrated, with distortion
+  cv::Size board{9, 6};     // inner corners
+  double square = 0.025;    // metres
+  double seconds = 10.0;    // of video
   double fps = 30.0;
-  double tracker_noise_deg = 0.75;   // RMS rotation error
-  double position_noise_m = 0.00254; // RMS per axis (ISOTRAK II: 0.1 in)
-  double latency_ms = 20.0;          // the simulated device's true latency
-  double assumed_latency_ms = 0.0;   // the latency session.json claims (what calibration corrects)
-  double image_noise = 1.5;          // 8-bit levels, standard deviation
+  double tracker_noise_deg = 0.75;    // RMS rotation error
+  double position_noise_m = 0.00254;  // RMS per axis (ISOTRAK II: 0.1 in)
+  double latency_ms = 20.0;           // the simulated device's true latency
+  double assumed_latency_ms = 0.0;    // the latency session.json claims (what calibration corrects)
+  double image_noise = 1.5;           // 8-bit levels, standard deviation
   std::string codec = "ffv1";
   std::uint64_t seed = 1;
 };

@@ -9,10 +9,10 @@
 #include <opencv2/core.hpp>
 #include <string>
 
-#include "lumar/capture/recording_writer.h"
-#include "lumar/capture/session.h"
 #include "lumar/base/camera.h"
 #include "lumar/base/pose.h"
+#include "lumar/capture/recording_writer.h"
+#include "lumar/capture/session.h"
 #include "lumar/tracking/simulated_tracker.h"
 
 namespace lumar::app {
@@ -24,9 +24,9 @@ struct SynthSettings {
   int frames = 48;
   double fps = 24.0;
   int supersample = 2;
-  double exposure = 0.0;             // video linear value per unit radiance; 0 = automatic
-  double read_noise = 0.002;         // linear units, standard deviation
-  double shot_noise_gain = 0.0004;   // variance per unit of linear signal
+  double exposure = 0.0;            // video linear value per unit radiance; 0 = automatic
+  double read_noise = 0.002;        // linear units, standard deviation
+  double shot_noise_gain = 0.0004;  // variance per unit of linear signal
   double vignetting_a = -0.30, vignetting_b = 0.05;
   double tracker_noise_deg = 0.75;   // RMS rotation error
   double position_noise_m = 0.0025;  // RMS per axis

@@ -23,8 +23,8 @@ namespace lumar::app {
 struct SweepSynthSettings {
   std::filesystem::path envmap;
   std::vector<double> exposure_stops{0.0, -5.0, -10.0};  // relative to 18 % grey of the map's mean
-  std::string exposure_mode = "bracket";                  // bracket | cycle
-  double move_seconds = 0.25;                             // bracket: time between stations
+  std::string exposure_mode = "bracket";                 // bracket | cycle
+  double move_seconds = 0.25;                            // bracket: time between stations
   glm::dvec3 capture_position{0.0, 1.5, 0.0};
 };
 

@@ -17,23 +17,23 @@
 #include <opencv2/core.hpp>
 #include <vector>
 
-#include "lumar/calib/camera_response.h"
 #include "lumar/base/camera.h"
+#include "lumar/calib/camera_response.h"
 #include "lumar/scene/envmap.h"
 
 namespace lumar::calib {
 
 struct StitchSettings {
-  int width = 1024;                      // map width; height = width / 2
-  CameraIntrinsics camera;               // calibrated, with distortion
-  CameraResponse response = srgb_response(1.0);  // 8-bit value -> linear video value
+  int width = 1024;                               // map width; height = width / 2
+  CameraIntrinsics camera;                        // calibrated, with distortion
+  CameraResponse response = srgb_response(1.0);   // 8-bit value -> linear video value
   double vignetting_a = 0.0, vignetting_b = 0.0;  // gain 1 + a r^2 + b r^4 (r over half-diagonal)
   glm::dvec3 capture_position{0.0};
   double azimuth_offset_deg = 0.0;
-  int saturated_value = 250;             // any channel at or above: clipped
-  int dark_value = 2;                    // every channel at or below: too dark to trust
-  double edge_weight = 0.05;             // centre weight at the image corners (1 at the centre)
-  bool prefilter = true;                 // sample a box-filtered level matching the map's pixel size
+  int saturated_value = 250;  // any channel at or above: clipped
+  int dark_value = 2;         // every channel at or below: too dark to trust
+  double edge_weight = 0.05;  // centre weight at the image corners (1 at the centre)
+  bool prefilter = true;      // sample a box-filtered level matching the map's pixel size
 };
 
 class EnvmapStitcher {
@@ -66,11 +66,11 @@ class EnvmapStitcher {
   std::vector<std::uint16_t> count_;
   // Where no sample was well exposed: the brightest clipped sample (a lower bound, from
   // the shortest exposure) or else the darkest near-black one (an upper bound).
-  std::vector<float> fallback_;          // R, G, B per pixel
-  std::vector<std::uint8_t> fallback_kind_;  // 0 none, 1 dark, 2 clipped
+  std::vector<float> fallback_;                  // R, G, B per pixel
+  std::vector<std::uint8_t> fallback_kind_;      // 0 none, 1 dark, 2 clipped
   std::array<std::array<float, 256>, 3> lut_{};  // BGR channel -> linear
-  double max_ray_r2_ = 0;        // largest squared normalised radius of a ray inside the image
-  double cone_half_angle_ = 0;   // angle from the optical axis that holds every image ray
+  double max_ray_r2_ = 0;                        // largest squared normalised radius of a ray inside the image
+  double cone_half_angle_ = 0;                   // angle from the optical axis that holds every image ray
   // One level of the frame's box pyramid: linear RGB, trust in [0, 1], clipped flag.
   struct Level {
     int width = 0, height = 0;

@@ -11,8 +11,8 @@
 #include <opencv2/core.hpp>
 #include <vector>
 
-#include "lumar/calib/camera_response.h"
 #include "lumar/base/camera.h"
+#include "lumar/calib/camera_response.h"
 
 namespace lumar::calib {
 
@@ -45,13 +45,13 @@ struct RefinementSettings {
 };
 
 struct RefinementResult {
-  std::vector<glm::dquat> rotations;    // refined R_world_camera, one per frame
-  std::vector<double> correction_deg;   // angle from the tracker's rotation to the refined one
-  int pairs = 0;                        // frame pairs that contributed
-  int matches = 0;                      // inlier matches over all pairs
-  int unmatched_frames = 0;             // frames whose group found no good pair (left at the tracker's)
-  double residual_before_deg = 0;       // RMS ray disagreement of the inliers, tracker rotations
-  double residual_after_deg = 0;        // the same, refined rotations
+  std::vector<glm::dquat> rotations;   // refined R_world_camera, one per frame
+  std::vector<double> correction_deg;  // angle from the tracker's rotation to the refined one
+  int pairs = 0;                       // frame pairs that contributed
+  int matches = 0;                     // inlier matches over all pairs
+  int unmatched_frames = 0;            // frames whose group found no good pair (left at the tracker's)
+  double residual_before_deg = 0;      // RMS ray disagreement of the inliers, tracker rotations
+  double residual_after_deg = 0;       // the same, refined rotations
 };
 
 // `tracker_rotations` are R_world_camera from the tracker, one per frame, in the same
@@ -62,8 +62,6 @@ struct RefinementResult {
 // when the sizes differ.
 RefinementResult refine_orientations(const std::vector<FrameFeatures>& features,
                                      const std::vector<glm::dquat>& tracker_rotations,
-                                     const RefinementSettings& settings = {},
-                                     const std::vector<int>& groups = {});
-
+                                     const RefinementSettings& settings = {}, const std::vector<int>& groups = {});
 
 }  // namespace lumar::calib

@@ -7,9 +7,7 @@
 
 namespace lumar {
 
-inline float srgb_to_linear(float v) {
-  return v <= 0.04045f ? v / 12.92f : std::pow((v + 0.055f) / 1.055f, 2.4f);
-}
+inline float srgb_to_linear(float v) { return v <= 0.04045f ? v / 12.92f : std::pow((v + 0.055f) / 1.055f, 2.4f); }
 inline float linear_to_srgb(float v) {
   v = v < 0.f ? 0.f : (v > 1.f ? 1.f : v);
   return v <= 0.0031308f ? v * 12.92f : 1.055f * std::pow(v, 1.f / 2.4f) - 0.055f;

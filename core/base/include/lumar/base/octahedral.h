@@ -15,8 +15,7 @@ inline double sign_not_zero(double v) { return v >= 0.0 ? 1.0 : -1.0; }
 inline glm::dvec2 octahedral_encode(const glm::dvec3& d) {
   const double l1 = std::abs(d.x) + std::abs(d.y) + std::abs(d.z);
   glm::dvec2 e(d.x / l1, d.z / l1);
-  if (d.y < 0.0)
-    e = glm::dvec2((1.0 - std::abs(e.y)) * sign_not_zero(e.x), (1.0 - std::abs(e.x)) * sign_not_zero(e.y));
+  if (d.y < 0.0) e = glm::dvec2((1.0 - std::abs(e.y)) * sign_not_zero(e.x), (1.0 - std::abs(e.x)) * sign_not_zero(e.y));
   return e;
 }
 

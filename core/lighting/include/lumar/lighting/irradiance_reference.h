@@ -10,8 +10,8 @@
 #include <span>
 #include <vector>
 
-#include "lumar/scene/envmap.h"
 #include "lumar/lighting/room_radiance.h"
+#include "lumar/scene/envmap.h"
 
 namespace lumar {
 

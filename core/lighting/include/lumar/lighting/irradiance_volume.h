@@ -51,7 +51,7 @@ VolumeSettings volume_settings_for(const std::string& method);
 
 // A dominant light as the volume evaluates it at a shading point.
 struct VolumeLight {
-  glm::dvec3 radiance{0.0};        // mean radiance (power / solid angle from the capture point)
+  glm::dvec3 radiance{0.0};  // mean radiance (power / solid angle from the capture point)
   double solid_angle = 0.0;
   glm::dvec3 direction{0.0};
   bool on_proxy = false;
@@ -85,20 +85,20 @@ class IrradianceVolume {
 
   // The data the GPU uploads (and evaluate reads).
   glm::dvec3 box_min{0.0}, box_max{0.0};
-  glm::ivec3 cells{1};                      // uniform level
+  glm::ivec3 cells{1};  // uniform level
   glm::dvec3 cell_size{1.0};
-  std::vector<std::uint8_t> refined;        // per cell, x fastest
+  std::vector<std::uint8_t> refined;  // per cell, x fastest
   // Per node of the fine lattice (2 cells + 1 per axis, x fastest): 4 (probe, weight)
   // pairs; probe -1 = unused.
   std::vector<std::array<int, 4>> node_probe;
   std::vector<std::array<float, 4>> node_weight;
-  std::vector<glm::vec4> probes;            // xyz position, w = 1 enabled / 0 disabled
+  std::vector<glm::vec4> probes;  // xyz position, w = 1 enabled / 0 disabled
   int irradiance_n = 0, depth_n = 0, atlas_columns = 1;
-  std::vector<float> irradiance_atlas;      // RGB, (n+2)^2 block per probe
-  std::vector<float> depth_atlas;           // RG: mean distance, mean squared distance
-  std::vector<float> sh;                    // 27 floats per probe (SH9 storage)
+  std::vector<float> irradiance_atlas;  // RGB, (n+2)^2 block per probe
+  std::vector<float> depth_atlas;       // RG: mean distance, mean squared distance
+  std::vector<float> sh;                // 27 floats per probe (SH9 storage)
   std::vector<VolumeLight> lights;
-  std::vector<float> light_visibility;      // lights.size() per probe
+  std::vector<float> light_visibility;  // lights.size() per probe
   // Per light on the proxy: shadow_n x shadow_n octahedral map of the distance from the
   // light to the nearest surface (no border; lights off the proxy leave theirs unused).
   // A lamp's shadow edge is sharper than the probe spacing, so per-probe visibility
@@ -106,7 +106,7 @@ class IrradianceVolume {
   int shadow_n = 0;
   std::vector<float> light_shadow;
   glm::dvec3 capture_position{0.0};
-  double normal_bias = 0.0;                 // metres, along n before the Chebyshev test
+  double normal_bias = 0.0;  // metres, along n before the Chebyshev test
 
   int atlas_width(int n) const { return atlas_columns * (n + 2); }
   int atlas_height(int n) const;
@@ -127,7 +127,7 @@ IrradianceVolume cached_irradiance_volume(const RoomRadiance& radiance, const gl
                                           std::filesystem::path cache_dir = {}, bool* loaded = nullptr);
 std::filesystem::path default_irradiance_cache_dir();
 // 64-bit hash of everything the volume depends on.
-std::uint64_t irradiance_volume_key(const RoomRadiance& radiance, const glm::dvec3& box_min,
-                                    const glm::dvec3& box_max, const VolumeSettings& settings);
+std::uint64_t irradiance_volume_key(const RoomRadiance& radiance, const glm::dvec3& box_min, const glm::dvec3& box_max,
+                                    const VolumeSettings& settings);
 
 }  // namespace lumar

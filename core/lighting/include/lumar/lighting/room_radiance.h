@@ -19,9 +19,9 @@
 #include <vector>
 
 #include "lumar/base/color.h"
+#include "lumar/lighting/ray_scene.h"
 #include "lumar/scene/envmap.h"
 #include "lumar/scene/mesh.h"
-#include "lumar/lighting/ray_scene.h"
 
 namespace lumar {
 
@@ -44,22 +44,22 @@ struct RadianceSettings {
 // A texel integrated exactly: a small area light where the capture point sees it.
 struct BrightTexel {
   glm::dvec3 radiance{0.0};
-  double solid_angle = 0.0;       // seen from the capture point, sr
-  glm::dvec3 direction{0.0};      // world, unit, from the capture point
-  bool on_proxy = false;          // false: at infinity (distant map, or the ray escaped)
-  glm::dvec3 position{0.0};       // on the proxy
-  glm::dvec3 normal{0.0};         // proxy normal at position, facing the capture point
-  int light = -1;                 // dominant light it belongs to, -1 none
+  double solid_angle = 0.0;   // seen from the capture point, sr
+  glm::dvec3 direction{0.0};  // world, unit, from the capture point
+  bool on_proxy = false;      // false: at infinity (distant map, or the ray escaped)
+  glm::dvec3 position{0.0};   // on the proxy
+  glm::dvec3 normal{0.0};     // proxy normal at position, facing the capture point
+  int light = -1;             // dominant light it belongs to, -1 none
 };
 
 // A cluster of bright texels, evaluated as one point source at its power-weighted centre.
 struct DominantLight {
-  glm::dvec3 power{0.0};          // Σ L Ω over its texels, seen from the capture point
-  glm::dvec3 direction{0.0};      // world, unit, from the capture point
+  glm::dvec3 power{0.0};      // Σ L Ω over its texels, seen from the capture point
+  glm::dvec3 direction{0.0};  // world, unit, from the capture point
   double solid_angle = 0.0;
   bool on_proxy = false;
   glm::dvec3 position{0.0}, normal{0.0};
-  std::vector<int> texels;        // indices into bright_texels()
+  std::vector<int> texels;  // indices into bright_texels()
 };
 
 class RoomRadiance {
@@ -86,8 +86,8 @@ class RoomRadiance {
   struct Sample {
     glm::dvec3 radiance{0.0};
     double distance = std::numeric_limits<double>::infinity();  // to the hit; inf = escaped
-    bool back_face = false;   // hit the back of a proxy triangle (p is inside geometry)
-    bool fallback = false;    // the capture point cannot see the hit
+    bool back_face = false;  // hit the back of a proxy triangle (p is inside geometry)
+    bool fallback = false;   // the capture point cannot see the hit
   };
   // Radiance from direction w (unit) at p, with bright texels contributing nothing
   // (they are summed exactly by bright_irradiance). Nearest texel.
@@ -97,9 +97,8 @@ class RoomRadiance {
 
   // Solid angle of a bright texel (or light: pass its data) seen from p, and the unit
   // direction from p to it. 0 when p is behind its surface.
-  double solid_angle_from(const glm::dvec3& p, bool on_proxy, const glm::dvec3& position,
-                          const glm::dvec3& normal, const glm::dvec3& direction, double solid_angle,
-                          glm::dvec3* toward) const;
+  double solid_angle_from(const glm::dvec3& p, bool on_proxy, const glm::dvec3& position, const glm::dvec3& normal,
+                          const glm::dvec3& direction, double solid_angle, glm::dvec3* toward) const;
   // Whether p sees the point (or, off the proxy, the direction to infinity).
   bool sees(const glm::dvec3& p, bool on_proxy, const glm::dvec3& position, const glm::dvec3& direction) const;
 

@@ -3,14 +3,14 @@
 // shaded from the environment map, composited over undistorted video. Set up once,
 // then one call per frame. Needs a current OpenGL context (gl/context.h).
 #include <memory>
-#include <optional>
 #include <opencv2/core.hpp>
+#include <optional>
 #include <vector>
 
 #include "lumar/base/camera.h"
+#include "lumar/lighting/sh.h"
 #include "lumar/render/renderer.h"
 #include "lumar/scene/scene.h"
-#include "lumar/lighting/sh.h"
 
 namespace lumar {
 
@@ -23,8 +23,7 @@ class Compositor {
   // `output_camera`: the undistorted camera the renderer draws with. `map_x`, `map_y`:
   // for each output pixel, where to sample the distorted video (may be empty when the
   // video is already undistorted).
-  Compositor(const Scene& scene, const CameraIntrinsics& output_camera, const cv::Mat& map_x,
-             const cv::Mat& map_y);
+  Compositor(const Scene& scene, const CameraIntrinsics& output_camera, const cv::Mat& map_x, const cv::Mat& map_y);
 
   // Composites one BGR8 video frame seen from T_world_camera (nullopt: no pose, the
   // undistorted video alone); `exposure` is the video's linear value per unit of scene radiance.

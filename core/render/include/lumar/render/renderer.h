@@ -9,16 +9,16 @@
 #include <array>
 #include <glm/glm.hpp>
 #include <memory>
+#include <opencv2/core.hpp>
 #include <optional>
 #include <span>
-#include <opencv2/core.hpp>
 #include <vector>
 
 #include "lumar/base/camera.h"
-#include "lumar/scene/envmap.h"
-#include "lumar/scene/mesh.h"
 #include "lumar/base/pose.h"
 #include "lumar/lighting/sh.h"
+#include "lumar/scene/envmap.h"
+#include "lumar/scene/mesh.h"
 
 namespace lumar {
 class IrradianceVolume;

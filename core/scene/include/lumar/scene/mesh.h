@@ -10,8 +10,8 @@ namespace lumar {
 
 struct Mesh {
   std::vector<glm::vec3> positions;
-  std::vector<glm::vec3> normals;        // one unit normal per vertex
-  std::vector<std::uint32_t> indices;    // three per triangle, counter-clockwise = front
+  std::vector<glm::vec3> normals;      // one unit normal per vertex
+  std::vector<std::uint32_t> indices;  // three per triangle, counter-clockwise = front
 
   std::size_t triangle_count() const { return indices.size() / 3; }
   std::pair<glm::vec3, glm::vec3> bounds() const;  // (min, max); zero box when empty

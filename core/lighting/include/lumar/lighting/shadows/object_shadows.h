@@ -27,9 +27,9 @@
 #include <memory>
 #include <vector>
 
-#include "lumar/scene/mesh.h"
 #include "lumar/lighting/shadows/shadow_cone.h"
 #include "lumar/lighting/shadows/shadow_emitters.h"
+#include "lumar/scene/mesh.h"
 
 namespace lumar {
 
@@ -79,12 +79,12 @@ class ObjectShadows {
     std::vector<std::uint32_t> order;  // vertices sorted spatially (model space), chunked
     glm::dmat4 T_world_model{1.0};
     glm::mat4 T_model_world{1.0f};
-    std::shared_ptr<const OccluderMesh> mesh;          // null: no triangles, casts no shadow
-    std::array<glm::vec3, 8> box{};                    // its boxes in world space, this pose
+    std::shared_ptr<const OccluderMesh> mesh;  // null: no triangles, casts no shadow
+    std::array<glm::vec3, 8> box{};            // its boxes in world space, this pose
     std::vector<std::array<glm::vec3, 8>> parts;
     // This pose, in `order`: world positions, normals, ray origins; chunks; box of all origins.
     std::vector<glm::vec3> position, normal, origin;
-    std::vector<glm::vec3> without;            // E_without, where without_known
+    std::vector<glm::vec3> without;  // E_without, where without_known
     std::vector<std::uint8_t> without_known;
     std::vector<Chunk> chunks, groups;
     glm::vec3 lo{0.0f}, hi{0.0f};

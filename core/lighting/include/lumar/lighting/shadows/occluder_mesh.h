@@ -67,10 +67,10 @@ class OccluderMesh {
   void occluded(StreamRay* rays, std::size_t n) const;
 
  private:
-  void* scene_ = nullptr;  // RTCScene: Embree stays out of this header
+  void* scene_ = nullptr;        // RTCScene: Embree stays out of this header
   struct alignas(64) Triangle {  // one cache line
-    glm::vec3 v0, e1, e2;         // a corner and the edges from it
-    float area2 = 0.0f;           // |e1 x e2|
+    glm::vec3 v0, e1, e2;        // a corner and the edges from it
+    float area2 = 0.0f;          // |e1 x e2|
     // Across edge k (the edge opposite corner k): the triangle sharing it, or
     // kNoTriangle (a border, or an edge shared by more than two triangles).
     std::array<std::uint32_t, 3> across{kNoTriangle, kNoTriangle, kNoTriangle};

@@ -8,8 +8,8 @@
 #include <glm/glm.hpp>
 #include <vector>
 
-#include "lumar/scene/envmap.h"
 #include "lumar/lighting/ray_scene.h"
+#include "lumar/scene/envmap.h"
 #include "lumar/scene/scene.h"
 
 namespace lumar {
@@ -45,7 +45,7 @@ struct EmitterOptions {
   int samples_per_patch = 8;         // sample points (line ends) per patch
   // 2004 baseline: keep only texels with luminance >= threshold x the mean (0 = all).
   double threshold_over_mean = 0.0;
-  std::vector<SceneBox> regions;     // non-empty: only texels whose proxy point lies inside one
+  std::vector<SceneBox> regions;  // non-empty: only texels whose proxy point lies inside one
 };
 
 // Builds the emitters of `map` seen from receivers around `receiver_centre` facing

@@ -34,15 +34,15 @@ struct ShadowLineOptions {
 
 struct ShadowLines {
   bool distant = false;
-  std::vector<glm::vec3> origins;        // shadow ray origins (receiver points nudged along their normal)
-  std::vector<EmitterPoint> samples;     // line ends (emitter sample points)
+  std::vector<glm::vec3> origins;     // shadow ray origins (receiver points nudged along their normal)
+  std::vector<EmitterPoint> samples;  // line ends (emitter sample points)
   std::uint32_t patch_count = 0;
-  ReceiverGrids grids;                           // over the origins
-  std::vector<ShadowLine> lines;                 // by sample, then by receiver in grids.order
-  std::vector<std::uint32_t> sample_first;       // sample s: lines[sample_first[s], sample_first[s+1])
-  std::vector<glm::vec3> unshadowed;             // E_without per receiver (with proxy visibility), RGB
-  std::vector<float> dropped;                    // share of E_without dropped per receiver (luminance-weighted max channel)
-  std::size_t candidate_lines = 0;               // lines with non-zero transfer before dropping
+  ReceiverGrids grids;                      // over the origins
+  std::vector<ShadowLine> lines;            // by sample, then by receiver in grids.order
+  std::vector<std::uint32_t> sample_first;  // sample s: lines[sample_first[s], sample_first[s+1])
+  std::vector<glm::vec3> unshadowed;        // E_without per receiver (with proxy visibility), RGB
+  std::vector<float> dropped;               // share of E_without dropped per receiver (luminance-weighted max channel)
+  std::size_t candidate_lines = 0;          // lines with non-zero transfer before dropping
 
   std::size_t receiver_count() const { return origins.size(); }
   // End point of a line (distant: kDistantLineLength away along the sample's direction).

@@ -11,12 +11,12 @@
 #include <string>
 #include <vector>
 
-#include "lumar/scene/envmap.h"
-#include "lumar/scene/mesh.h"
 #include "lumar/lighting/ray_scene.h"
-#include "lumar/scene/scene.h"
 #include "lumar/lighting/shadows/shadow_emitters.h"
 #include "lumar/lighting/shadows/shadow_lines.h"
+#include "lumar/scene/envmap.h"
+#include "lumar/scene/mesh.h"
+#include "lumar/scene/scene.h"
 
 namespace lumar {
 

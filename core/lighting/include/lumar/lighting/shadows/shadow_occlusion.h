@@ -18,9 +18,9 @@
 #include <memory>
 #include <vector>
 
-#include "lumar/scene/mesh.h"
 #include "lumar/lighting/shadows/shadow_cone.h"
 #include "lumar/lighting/shadows/shadow_lines.h"
+#include "lumar/scene/mesh.h"
 
 namespace lumar {
 
@@ -28,11 +28,11 @@ class OccluderMesh;
 
 struct ShadowFrameStats {
   bool recomputed = false;
-  std::size_t rows_scanned = 0;       // grid rows a cone's footprint was scanned along
+  std::size_t rows_scanned = 0;      // grid rows a cone's footprint was scanned along
   std::size_t receivers_tested = 0;  // receivers in a footprint, tested against the cone
-  std::size_t rays_traced = 0;   // candidate lines traced (culling off: every line)
+  std::size_t rays_traced = 0;       // candidate lines traced (culling off: every line)
   std::size_t lines_blocked = 0;
-  std::size_t lines_walked = 0;  // blocked lines proven by a walk from last frame's blocker, without Embree
+  std::size_t lines_walked = 0;      // blocked lines proven by a walk from last frame's blocker, without Embree
   double cull_ms = 0, trace_ms = 0;  // CPU time (calling thread) of the culling and of the ray tracing
 };
 
@@ -67,8 +67,8 @@ class LineShadows {
   struct Object {
     glm::dmat4 T_world_model{1.0};
     glm::mat4 T_model_world{1.0f};
-    std::shared_ptr<const OccluderMesh> mesh;        // null: no triangles, casts no shadow
-    std::vector<std::array<glm::vec3, 8>> parts;     // its pieces' boxes in world space, this pose
+    std::shared_ptr<const OccluderMesh> mesh;     // null: no triangles, casts no shadow
+    std::vector<std::array<glm::vec3, 8>> parts;  // its pieces' boxes in world space, this pose
     // This frame, model space: every receiver's ray origin, every sample's line end
     // (distant: the line's direction and length).
     std::vector<glm::vec3> origin_model, sample_model;
@@ -96,14 +96,15 @@ class LineShadows {
     std::uint32_t line, receiver, sample;
   };
   std::vector<Candidate> candidates_;  // this object's, by sample then grid order
-  std::vector<float> ordered_u_, ordered_v_;  // receiver origins in grid order (ShadowLines::grids.order), in their grid's (u, v)
+  std::vector<float> ordered_u_,
+      ordered_v_;  // receiver origins in grid order (ShadowLines::grids.order), in their grid's (u, v)
   // Per (sample, chunk of 64 receivers in grid order): which have a line, and the first line.
   std::size_t chunks_ = 0;
   std::vector<std::uint64_t> chunk_mask_;
   std::vector<std::uint32_t> chunk_first_;
-  std::vector<std::uint64_t> hits_;          // this sample: receivers (grid order) inside a piece's cone
-  std::vector<std::uint32_t> hit_chunks_;    // chunks of hits_ that are non-zero
-  std::vector<std::uint8_t> all_blocked_;    // the baseline: per line
+  std::vector<std::uint64_t> hits_;        // this sample: receivers (grid order) inside a piece's cone
+  std::vector<std::uint32_t> hit_chunks_;  // chunks of hits_ that are non-zero
+  std::vector<std::uint8_t> all_blocked_;  // the baseline: per line
 };
 
 }  // namespace lumar

@@ -4,8 +4,8 @@
 // not depend on where the object stands.
 #include <vector>
 
-#include "lumar/scene/mesh.h"
 #include "lumar/lighting/ray_scene.h"
+#include "lumar/scene/mesh.h"
 #include "lumar/scene/scene.h"
 
 namespace lumar {
