@@ -93,4 +93,17 @@ case_bad_method_and_map() {
     "$LUMAR" irradiance --query "$TMP/q.csv" --out "$TMP/out.csv"
 }
 
+case_embree_isa_setting() {
+  # LUMAR_EMBREE_ISA (scripts/test.sh --isa) picks Embree's kernels; an unknown name is
+  # one line and status 2, and a set the CPU has gives the same irradiance as the default.
+  queries
+  LUMAR_EMBREE_ISA=sse3 expect_bad_input "LUMAR_EMBREE_ISA=sse3" "$TMP/bad.csv" -- \
+    "$LUMAR" irradiance --scene "$SCENE" --query "$TMP/q.csv" --out "$TMP/bad.csv" --method reference --strata 8
+  "$LUMAR" irradiance --scene "$SCENE" --query "$TMP/q.csv" --out "$TMP/default.csv" --method reference --strata 16 \
+    >/dev/null 2>&1 || fail "reference irradiance failed"
+  LUMAR_EMBREE_ISA=sse2 "$LUMAR" irradiance --scene "$SCENE" --query "$TMP/q.csv" --out "$TMP/sse2.csv" \
+    --method reference --strata 16 >/dev/null 2>&1 || fail "reference irradiance with LUMAR_EMBREE_ISA=sse2 failed"
+  compare "$TMP/sse2.csv" "$TMP/default.csv" 1e-4
+}
+
 run_case

@@ -97,6 +97,53 @@ TEST(RayScene, StaticMeshAndBatchQueriesAgree) {
   EXPECT_FLOAT_EQ(hit->t, 1.0f);  // direction length 2: t in its units
   EXPECT_EQ(hit->instance, -1);
   EXPECT_EQ(hit->normal, glm::vec3(0, 1, 0));
+  EXPECT_FALSE(hit->back_face);
+  const auto from_below = scene.intersect({{0.2f, -2.0f, 0.3f}, 0.0f, {0.0f, 1.0f, 0.0f}, 10.0f});
+  ASSERT_TRUE(from_below);
+  EXPECT_TRUE(from_below->back_face);
+  EXPECT_EQ(from_below->normal, glm::vec3(0, -1, 0));  // facing against the ray
+}
+
+// A box standing on the floor: its bottom face and the floor lie in one plane, so a ray
+// from inside the box meets both at the same distance. Which one Embree reports depends
+// on its kernels (the instruction set it picked); intersect() must say "back face" either
+// way, since the ray starts inside geometry. Checked for both orders of adding the two
+// meshes and for the box as an instance.
+TEST(RayScene, CoincidentFacesFromInsideGeometryAreBackFaces) {
+  Mesh floor;
+  floor.positions = {{-2, 0, -2}, {2, 0, -2}, {2, 0, 2}, {-2, 0, 2}};
+  floor.normals.assign(4, {0, 1, 0});
+  floor.indices = {0, 2, 1, 0, 3, 2};
+  Mesh box;  // [-0.5, 0.5] x [0, 1] x [-0.5, 0.5], faces outwards
+  for (int k = 0; k < 8; ++k)
+    box.positions.push_back({k & 1 ? 0.5f : -0.5f, k & 2 ? 1.0f : 0.0f, k & 4 ? 0.5f : -0.5f});
+  box.normals.assign(8, {0, 1, 0});
+  box.indices = {0, 1, 5, 0, 5, 4, 2, 6, 7, 2, 7, 3, 0, 4, 6, 0, 6, 2,
+                 1, 3, 7, 1, 7, 5, 0, 2, 3, 0, 3, 1, 4, 5, 7, 4, 7, 6};
+  const glm::dmat4 lift = glm::translate(glm::dmat4(1.0), glm::dvec3(0.3, 0.0, -0.2));
+  for (int variant = 0; variant < 3; ++variant) {
+    RayScene scene;
+    glm::dvec3 offset(0.0);
+    if (variant == 0) scene.add_static(floor), scene.add_static(box);
+    if (variant == 1) scene.add_static(box), scene.add_static(floor);
+    if (variant == 2) scene.add_instance(box, lift), scene.add_static(floor), offset = glm::dvec3(lift[3]);
+    scene.commit();
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<float> u(-0.45f, 0.45f);
+    for (int i = 0; i < 200; ++i) {
+      const glm::vec3 inside = glm::vec3(offset) + glm::vec3(u(rng), 0.5f + u(rng), u(rng));
+      const auto down = scene.intersect({inside, 0.0f, {0.0f, -1.0f, 0.0f}, 10.0f});
+      ASSERT_TRUE(down);
+      EXPECT_TRUE(down->back_face) << "variant " << variant << ", ray " << i;
+      EXPECT_NEAR(down->t, inside.y, 1e-5f);
+      EXPECT_EQ(down->normal, glm::vec3(0, 1, 0)) << "variant " << variant;  // facing against the ray
+      // Outside the box the floor is the only face there: a front face.
+      const glm::vec3 beside = inside + glm::vec3(1.2f, 0.0f, 0.0f);
+      const auto floor_hit = scene.intersect({beside, 0.0f, {0.0f, -1.0f, 0.0f}, 10.0f});
+      ASSERT_TRUE(floor_hit);
+      EXPECT_FALSE(floor_hit->back_face);
+    }
+  }
 }
 
 }  // namespace

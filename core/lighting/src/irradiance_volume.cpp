@@ -186,7 +186,6 @@ struct ProbeBuilder {
     *back = 0;
     *nearest = std::numeric_limits<double>::infinity();
     const RayScene& rays = *radiance.ray_scene();
-    const Mesh& proxy = radiance.proxy();
     for (const glm::dvec3& w : quick_directions) {
       Ray ray;
       ray.origin = glm::vec3(p);
@@ -194,9 +193,7 @@ struct ProbeBuilder {
       const auto hit = rays.intersect(ray);
       if (!hit) continue;
       *nearest = std::min(*nearest, double(hit->t));
-      const std::uint32_t* tri = &proxy.indices[std::size_t(hit->triangle) * 3];
-      const glm::dvec3 a(proxy.positions[tri[0]]), b(proxy.positions[tri[1]]), c(proxy.positions[tri[2]]);
-      if (glm::dot(glm::cross(b - a, c - a), w) > 0.0) ++*back;
+      if (hit->back_face) ++*back;
     }
   }
 

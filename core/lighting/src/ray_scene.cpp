@@ -1,34 +1,17 @@
 #include "lumar/lighting/ray_scene.h"
 
 #include <embree3/rtcore.h>
-#include <spdlog/spdlog.h>
 
 #include <algorithm>
 #include <mutex>
 #include <vector>
 
+#include "embree_device.h"
 #include "lumar/base/error.h"
 
 namespace lumar {
 
 namespace {
-
-void report_embree_error(void*, RTCError code, const char* message) {
-  if (code != RTC_ERROR_NONE) spdlog::error("Embree: {}", message ? message : "unknown error");
-}
-
-// One Embree device for the process: creating one per scene costs milliseconds and
-// starts its own thread pool.
-RTCDevice shared_device() {
-  static RTCDevice device = [] {
-    RTCDevice d = rtcNewDevice("threads=0");
-    if (!d)
-      throw RuntimeError("Embree: cannot create a device (" + std::to_string(int(rtcGetDeviceError(nullptr))) + ")");
-    rtcSetDeviceErrorFunction(d, report_embree_error, nullptr);
-    return d;
-  }();
-  return device;
-}
 
 RTCGeometry make_triangles(RTCDevice device, const Mesh& mesh) {
   RTCGeometry geom = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
@@ -68,13 +51,43 @@ RTCRay to_rtc(const Ray& ray) {
 }  // namespace
 
 struct RayScene::Impl {
-  RTCDevice device = shared_device();
+  RTCDevice device = embree_device();
   RTCScene top = rtcNewScene(device);
   std::vector<RTCScene> instanced;     // one scene per instance's mesh
   std::vector<RTCGeometry> instances;  // instance geometries, by instance id
   std::vector<glm::dmat4> instance_to_world;
   std::vector<unsigned> static_geom_ids;
   bool any_geometry = false;
+
+  // Instance ids are attach order among instances; find ours by its geometry id.
+  int instance_index(unsigned geom_id) const {
+    RTCGeometry g = rtcGetGeometry(top, geom_id);
+    return int(std::find(instances.begin(), instances.end(), g) - instances.begin());
+  }
+  // A hit's geometric normal in world space (Embree's Ng is in the instance's own space).
+  glm::dvec3 world_normal(unsigned instance_geom_id, const glm::dvec3& ng) const {
+    if (instance_geom_id == RTC_INVALID_GEOMETRY_ID) return ng;
+    const glm::dmat4& m = instance_to_world[std::size_t(instance_index(instance_geom_id))];
+    return glm::transpose(glm::inverse(glm::dmat3(m))) * ng;
+  }
+
+  // The second look at a front-face hit's distance (see intersect): the context carries
+  // the scene and the ray's world direction, and only back faces pass.
+  struct BackFaceContext {
+    RTCIntersectContext context;
+    const Impl* impl;
+    glm::dvec3 world_direction;
+  };
+  static void keep_back_faces(const RTCFilterFunctionNArguments* args) {
+    const auto* c = reinterpret_cast<const BackFaceContext*>(args->context);
+    for (unsigned i = 0; i < args->N; ++i) {
+      if (args->valid[i] == 0) continue;
+      const glm::dvec3 ng(RTCHitN_Ng_x(args->hit, args->N, i), RTCHitN_Ng_y(args->hit, args->N, i),
+                          RTCHitN_Ng_z(args->hit, args->N, i));
+      const glm::dvec3 n = c->impl->world_normal(RTCHitN_instID(args->hit, args->N, i, 0), ng);
+      if (!(glm::dot(n, c->world_direction) > 0.0)) args->valid[i] = 0;
+    }
+  }
 
   ~Impl() {
     for (RTCGeometry g : instances) rtcReleaseGeometry(g);
@@ -84,7 +97,8 @@ struct RayScene::Impl {
 };
 
 RayScene::RayScene() : impl_(std::make_unique<Impl>()) {
-  rtcSetSceneBuildQuality(impl_->top, RTC_BUILD_QUALITY_LOW);  // the top level changes every frame
+  rtcSetSceneBuildQuality(impl_->top, RTC_BUILD_QUALITY_LOW);            // the top level changes every frame
+  rtcSetSceneFlags(impl_->top, RTC_SCENE_FLAG_CONTEXT_FILTER_FUNCTION);  // keep_back_faces
 }
 RayScene::~RayScene() = default;
 
@@ -104,6 +118,7 @@ std::uint32_t RayScene::add_static(const Mesh& world_mesh) {
 int RayScene::add_instance(const Mesh& model_mesh, const glm::dmat4& T_world_model) {
   RTCScene scene = rtcNewScene(impl_->device);
   rtcSetSceneBuildQuality(scene, RTC_BUILD_QUALITY_HIGH);  // built once, traced many times
+  rtcSetSceneFlags(scene, RTC_SCENE_FLAG_CONTEXT_FILTER_FUNCTION);
   if (model_mesh.triangle_count() > 0) {
     RTCGeometry geom = make_triangles(impl_->device, model_mesh);
     rtcAttachGeometry(scene, geom);
@@ -142,24 +157,43 @@ std::optional<RayHit> RayScene::intersect(const Ray& ray) const {
   rtcIntersect1(impl_->top, &context, &rh);
   if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return std::nullopt;
 
+  const glm::dvec3 direction(ray.direction);
+  glm::dvec3 n = impl_->world_normal(rh.hit.instID[0], glm::dvec3(rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z));
+  if (!(glm::dot(n, direction) > 0.0)) {
+    // Two faces at the same distance (a box standing on the floor, a wall meeting the
+    // ceiling) are a tie that Embree's kernels break differently on different CPUs. A
+    // back face there means the ray starts inside geometry, so it wins: look again,
+    // within a hair of the hit, for back faces only.
+    const float t = rh.ray.tfar;
+    const float hair = 1e-5f * t + 1e-6f / std::max(glm::length(ray.direction), 1e-12f);
+    Impl::BackFaceContext back{{}, impl_.get(), direction};
+    rtcInitIntersectContext(&back.context);
+    back.context.filter = Impl::keep_back_faces;
+    RTCRayHit again{};
+    again.ray = to_rtc(ray);
+    again.ray.tnear = std::max(ray.t_near, t - hair);
+    again.ray.tfar = std::min(ray.t_far, t + hair);
+    again.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    again.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+    rtcIntersect1(impl_->top, &back.context, &again);
+    if (again.hit.geomID != RTC_INVALID_GEOMETRY_ID) {
+      rh = again;
+      n = impl_->world_normal(rh.hit.instID[0], glm::dvec3(rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z));
+    }
+  }
+
   RayHit hit;
   hit.t = rh.ray.tfar;
   hit.triangle = rh.hit.primID;
-  glm::dvec3 n(rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z);  // object space for instances
   if (rh.hit.instID[0] != RTC_INVALID_GEOMETRY_ID) {
-    // Instance ids are attach order among instances; find ours by geometry handle.
-    RTCGeometry g = rtcGetGeometry(impl_->top, rh.hit.instID[0]);
-    const auto it = std::find(impl_->instances.begin(), impl_->instances.end(), g);
-    hit.instance = int(it - impl_->instances.begin());
-    const glm::dmat4& m = impl_->instance_to_world[std::size_t(hit.instance)];
-    n = glm::transpose(glm::inverse(glm::dmat3(m))) * n;
+    hit.instance = impl_->instance_index(rh.hit.instID[0]);
   } else {
     const auto it = std::find(impl_->static_geom_ids.begin(), impl_->static_geom_ids.end(), rh.hit.geomID);
     hit.mesh = std::uint32_t(it - impl_->static_geom_ids.begin());
   }
   n = glm::normalize(n);
-  if (glm::dot(n, glm::dvec3(ray.direction)) > 0.0) n = -n;
-  hit.normal = glm::vec3(n);
+  hit.back_face = glm::dot(n, direction) > 0.0;
+  hit.normal = glm::vec3(hit.back_face ? -n : n);
   return hit;
 }
 

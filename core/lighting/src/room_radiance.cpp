@@ -225,9 +225,7 @@ RoomRadiance::Sample RoomRadiance::lookup(const glm::dvec3& p, const glm::dvec3&
     if (const auto hit = rays_->intersect(ray)) {
       s.distance = hit->t;
       const glm::dvec3 x = p + w * double(hit->t);
-      const std::uint32_t* tri = &proxy_.indices[std::size_t(hit->triangle) * 3];
-      const glm::dvec3 a(proxy_.positions[tri[0]]), b(proxy_.positions[tri[1]]), c(proxy_.positions[tri[2]]);
-      s.back_face = glm::dot(glm::cross(b - a, c - a), w) > 0.0;
+      s.back_face = hit->back_face;
       map_dir = x - map_.capture_position;
       const double len = glm::length(map_dir);
       if (len > 1e-6) {

@@ -10,6 +10,7 @@
 #include <string>
 
 #include "cpu_clones.h"
+#include "embree_device.h"
 #include "lumar/base/error.h"
 
 namespace lumar {
@@ -120,22 +121,6 @@ void record_blocker(const RTCFilterFunctionNArguments* args) {
     reinterpret_cast<BlockerContext*>(args->context)->triangle = RTCHitN_primID(args->hit, 1, 0);
 }
 
-void report_embree_error(void*, RTCError code, const char* message) {
-  if (code != RTC_ERROR_NONE)
-    throw RuntimeError(std::string("Embree (shadow meshes): ") + (message ? message : "error"));
-}
-
-// The model-space BVHs live on their own device (RayScene keeps its device private).
-RTCDevice bvh_device() {
-  static RTCDevice device = [] {
-    RTCDevice d = rtcNewDevice("threads=0");
-    if (!d) throw RuntimeError("Embree: cannot create a device for the shadow meshes");
-    rtcSetDeviceErrorFunction(d, report_embree_error, nullptr);
-    return d;
-  }();
-  return device;
-}
-
 }  // namespace
 
 OccluderMesh::OccluderMesh(const Mesh& model) {
@@ -163,7 +148,7 @@ OccluderMesh::OccluderMesh(const Mesh& model) {
       for (int k = 0; k < 3; ++k) m.indices.push_back(model.indices[3 * t + std::uint32_t(k)]);
   }
 
-  RTCDevice device = bvh_device();
+  RTCDevice device = embree_device();
   RTCScene scene = rtcNewScene(device);
   rtcSetSceneBuildQuality(scene, RTC_BUILD_QUALITY_HIGH);           // built once, traced every frame
   rtcSetSceneFlags(scene, RTC_SCENE_FLAG_CONTEXT_FILTER_FUNCTION);  // record_blocker

@@ -22,6 +22,8 @@ struct Ray {
 struct RayHit {
   float t = 0.0f;
   glm::vec3 normal{0.0f};  // unit geometric normal in world space, facing against the ray
+  bool back_face = false;  // the ray met the triangle's back (counter-clockwise = front): it
+                           // starts inside geometry. Of faces at the same distance, a back face wins.
   int instance = -1;       // -1: static geometry; otherwise the id add_instance returned
   std::uint32_t mesh = 0;  // which static mesh (add_static order) when instance == -1
   std::uint32_t triangle = 0;
