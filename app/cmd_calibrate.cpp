@@ -8,6 +8,7 @@
 
 #include "commands.h"
 #include "lumar/base/error.h"
+#include "lumar/base/glob.h"
 #include "lumar/calib/calibration_report.h"
 #include "lumar/calib/charuco_calibration.h"
 #include "lumar/calib/checkerboard_calibration.h"
@@ -44,18 +45,16 @@ cv::Size parse_board(const std::string& option, const std::string& text, const c
   return {w, h};
 }
 
-// Expands globs (OpenCV's cv::glob) and keeps plain paths as given.
+// Expands globs (lumar/base/glob.h) and keeps plain paths as given.
 std::vector<std::filesystem::path> expand(const std::vector<std::string>& patterns) {
   std::vector<std::filesystem::path> out;
   for (const auto& p : patterns) {
-    if (p.find_first_of("*?[") == std::string::npos) {
+    if (!is_glob_pattern(p)) {
       out.emplace_back(p);
       continue;
     }
-    std::vector<cv::String> found;
-    cv::glob(p, found, false);
+    const auto found = glob_files(p);
     if (found.empty()) throw InputError(p + ": no file matches this pattern");
-    std::sort(found.begin(), found.end());
     out.insert(out.end(), found.begin(), found.end());
   }
   return out;

@@ -10,6 +10,7 @@
 
 #include "commands.h"
 #include "lumar/base/error.h"
+#include "lumar/base/output_file.h"
 #include "lumar/lighting/irradiance_reference.h"
 #include "lumar/lighting/irradiance_scene.h"
 
@@ -80,28 +81,13 @@ Query read_queries(const std::string& path) {
 }
 
 void write_results(const std::string& path, const std::vector<glm::dvec3>& e) {
-  const std::string tmp = path + ".tmp";
-  {
-    std::ofstream out(tmp, std::ios::trunc);
-    if (!out) throw InputError(path + ": cannot write the output; check that the folder exists and is writable");
-    out << "r,g,b\n";
-    char buf[96];
-    for (const glm::dvec3& v : e) {
-      std::snprintf(buf, sizeof(buf), "%.9g,%.9g,%.9g\n", v.r, v.g, v.b);
-      out << buf;
-    }
-    out.flush();
-    if (!out) {
-      std::remove(tmp.c_str());
-      throw RuntimeError(path + ": writing the output failed (disk full?)");
-    }
+  std::string csv = "r,g,b\n";
+  char buf[96];
+  for (const glm::dvec3& v : e) {
+    std::snprintf(buf, sizeof(buf), "%.9g,%.9g,%.9g\n", v.r, v.g, v.b);
+    csv += buf;
   }
-  std::error_code ec;
-  std::filesystem::rename(tmp, path, ec);
-  if (ec) {
-    std::remove(tmp.c_str());
-    throw RuntimeError(path + ": cannot write the output (" + ec.message() + ")");
-  }
+  write_file_atomically(path, csv);
 }
 
 void run(const IrradianceOptions& o) {

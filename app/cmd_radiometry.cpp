@@ -10,10 +10,11 @@
 
 #include "commands.h"
 #include "lumar/base/error.h"
+#include "lumar/base/output_file.h"
 #include "lumar/calib/camera_file.h"
 #include "lumar/calib/camera_response.h"
+#include "lumar/calib/image_file.h"
 #include "lumar/calib/vignetting.h"
-#include "lumar/capture/durable_file.h"
 #include "lumar/capture/session.h"
 
 namespace lumar::app {
@@ -41,7 +42,7 @@ void update_session_radiometry(const std::filesystem::path& recording, const nlo
   }
   for (const auto& [key, value] : changes.items()) j["radiometry"][key] = value;
   capture::session_from_json(j, file.string());  // throws InputError if the result is invalid
-  capture::write_file_atomically(file, j.dump(2) + "\n");
+  write_file_atomically(file, j.dump(2) + "\n");
 }
 
 struct ResponseOptions {
@@ -61,10 +62,7 @@ void run_response(const ResponseOptions& o) {
   calib::save_camera_response(o.out, response);
   if (!o.hdr.empty()) {
     const cv::Mat hdr = calib::merge_hdr(images, o.times, response);
-    // cv::imwrite picks the format by extension, so the temporary name keeps it.
-    const std::filesystem::path final_path(o.hdr), tmp = final_path.string() + ".tmp.hdr";
-    if (!cv::imwrite(tmp.string(), hdr)) throw RuntimeError(o.hdr + ": cannot write the merged HDR image");
-    std::filesystem::rename(tmp, final_path);
+    calib::write_image_atomically(o.hdr, hdr);
   }
   if (!o.session.empty())
     update_session_radiometry(o.session, {{"response", std::filesystem::absolute(o.out).string()}});

@@ -11,6 +11,8 @@
 
 #include "commands.h"
 #include "lumar/base/error.h"
+#include "lumar/base/output_file.h"
+#include "lumar/calib/image_file.h"
 #include "lumar/pipeline/replay_overlay.h"
 
 namespace lumar::app {
@@ -78,16 +80,6 @@ json read_json(const fs::path& file) {
   }
 }
 
-void write_json_atomically(const fs::path& file, const json& j) {
-  const fs::path tmp = file.string() + ".tmp";
-  {
-    std::ofstream out(tmp);
-    out << j.dump(2) << "\n";
-    if (!out) throw RuntimeError(tmp.string() + ": cannot write");
-  }
-  fs::rename(tmp, file);
-}
-
 struct Outcome {
   bool pass = true;
   std::string line;
@@ -134,7 +126,7 @@ Outcome regress_one(const fs::path& dir, bool update) {
       throw InputError(dir.string() + ": golden frame " + std::to_string(index) + " is not in the video");
     const fs::path png = dir / "expected" / fmt::format("frame-{:06d}.png", index);
     if (update) {
-      if (!cv::imwrite(png.string(), outputs[index])) throw RuntimeError(png.string() + ": cannot write");
+      calib::write_image_atomically(png, outputs[index]);
       psnrs.push_back(99.0);
     } else {
       const cv::Mat want = cv::imread(png.string(), cv::IMREAD_COLOR);
@@ -165,7 +157,7 @@ Outcome regress_one(const fs::path& dir, bool update) {
                   {"tracked_projection_worst_frame_px", tracked_max},
                   {"render_projection_mean_px", render_error},
                   {"render_projection_pixels", render_samples}}}};
-    write_json_atomically(expected_file, expected);
+    write_file_atomically(expected_file, expected.dump(2) + "\n");
   }
   const double psnr_limit = expected.at("psnr_min_db").get<double>();
   const double tracked_limit = expected.at("tracked_projection_mean_px_max").get<double>();

@@ -8,6 +8,7 @@
 
 #include "commands.h"
 #include "lumar/base/error.h"
+#include "lumar/base/output_file.h"
 #include "lumar/lighting/shadows/shadow_methods.h"
 #include "lumar/scene/scene.h"
 
@@ -62,23 +63,13 @@ void read_query(const std::filesystem::path& path, std::vector<glm::vec3>& posit
 }
 
 void write_result(const std::filesystem::path& path, const std::vector<glm::vec3>& attenuation) {
-  const std::filesystem::path tmp = path.string() + ".tmp";
-  {
-    std::ofstream out(tmp);
-    if (!out) throw InputError(path.string() + ": cannot write the output (does its folder exist?)");
-    out << "r,g,b\n";
-    char buf[96];
-    for (const glm::vec3& a : attenuation) {
-      std::snprintf(buf, sizeof buf, "%.6f,%.6f,%.6f\n", a.r, a.g, a.b);
-      out << buf;
-    }
-    out.flush();
-    if (!out) {
-      std::filesystem::remove(tmp);
-      throw RuntimeError(path.string() + ": writing failed (disk full?)");
-    }
+  std::string csv = "r,g,b\n";
+  char buf[96];
+  for (const glm::vec3& a : attenuation) {
+    std::snprintf(buf, sizeof buf, "%.6f,%.6f,%.6f\n", a.r, a.g, a.b);
+    csv += buf;
   }
-  std::filesystem::rename(tmp, path);
+  write_file_atomically(path, csv);
 }
 
 }  // namespace

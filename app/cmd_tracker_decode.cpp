@@ -11,6 +11,7 @@
 
 #include "commands.h"
 #include "lumar/base/error.h"
+#include "lumar/base/output_file.h"
 #include "lumar/capture/recording_format.h"
 #include "lumar/tracking/tracker_decode.h"
 // parse_tracker_chunks is private to capture/ (capture/src); the decoder needs exactly
@@ -76,24 +77,9 @@ void run_decode(const DecodeOptions& o) {
     counts = tracking::decode_to_csv(chunks, format, std::cout);
     std::cout.flush();
   } else {
-    // Whole or not at all: write beside the target and rename.
-    const std::string tmp = o.out + ".tmp";
-    {
-      std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-      if (!out) throw InputError(o.out + ": cannot be created; check the folder exists and is writable");
-      counts = tracking::decode_to_csv(chunks, format, out);
-      out.close();
-      if (!out) {
-        std::filesystem::remove(tmp);
-        throw RuntimeError(o.out + ": write failed (disk full?); free space and retry");
-      }
-    }
-    std::error_code ec;
-    std::filesystem::rename(tmp, o.out, ec);
-    if (ec) {
-      std::filesystem::remove(tmp);
-      throw RuntimeError(o.out + ": cannot be put in place (" + ec.message() + ")");
-    }
+    std::ostringstream csv;
+    counts = tracking::decode_to_csv(chunks, format, csv);
+    write_file_atomically(o.out, csv.str());
   }
   std::string summary = o.file + ": " + tracking::decode_summary(counts);
   if (torn_chunk_bytes > 0) summary += ", " + std::to_string(torn_chunk_bytes) + " bytes of a torn chunk ignored";

@@ -10,6 +10,9 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "lumar/base/output_file.h"
+#include "lumar/calib/image_file.h"
+
 namespace lumar::bench {
 
 void BenchReport::compute_ratios() {
@@ -30,9 +33,7 @@ void BenchReport::write_json(const std::filesystem::path& file) const {
     if (!std::isnan(e.x)) row["x"] = e.x;
     j["entries"].push_back(row);
   }
-  const auto tmp = file.string() + ".tmp";
-  std::ofstream(tmp) << j.dump(2) << "\n";
-  std::filesystem::rename(tmp, file);
+  write_file_atomically(file, j.dump(2) + "\n");
 }
 
 namespace {
@@ -153,9 +154,7 @@ void BenchReport::write_chart(const std::filesystem::path& file) const {
       text(img, e.name, p + cv::Point(8, -6), 0.4);
     }
   }
-  const auto tmp = file.parent_path() / (".tmp-" + file.filename().string());
-  cv::imwrite(tmp.string(), img);
-  std::filesystem::rename(tmp, file);
+  calib::write_image_atomically(file, img);
 }
 
 void BenchReport::save(const std::filesystem::path& dir) const {

@@ -28,6 +28,7 @@
 #include <vector>
 
 #include "bench_report.h"
+#include "lumar/base/output_file.h"
 #include "lumar/tracking/one_euro_filter.h"
 #include "lumar/tracking/pose_conversion.h"
 #include "lumar/tracking/record_parser.h"
@@ -238,19 +239,19 @@ int main(int argc, char** argv) {
   // Every metric of every setting, for the record (the chart shows two of them).
   const auto table = bench::results_dir() / "tracker_filter_table.csv";
   {
-    std::ofstream csv(table.string() + ".tmp");
-    csv << "setting,min_cutoff_hz,beta,d_cutoff_hz,jitter_deg,jitter_px,jitter_mm,lag_ms,onset_ms,drag_px_at_30dps\n";
+    std::string csv;
+    csv += "setting,min_cutoff_hz,beta,d_cutoff_hz,jitter_deg,jitter_px,jitter_mm,lag_ms,onset_ms,drag_px_at_30dps\n";
     for (std::size_t i = 0; i < rows.size(); ++i) {
       const Row& r = rows[i];
       const auto& f = settings[i].filter;
-      csv << fmt::format("{},{},{},{},{:.4f},{:.3f},{:.3f},{:.2f},{:.2f},{:.2f}\n", r.name,
+      csv += fmt::format("{},{},{},{},{:.4f},{:.3f},{:.3f},{:.2f},{:.2f},{:.2f}\n", r.name,
                          f ? fmt::format("{:g}", f->rotation.min_cutoff_hz) : "",
                          f ? fmt::format("{:g}", f->rotation.beta) : "",
                          f ? fmt::format("{:g}", f->rotation.d_cutoff_hz) : "", r.jitter_deg, deg_to_px(r.jitter_deg),
                          r.jitter_mm, r.lag_ms, r.onset_ms, px_at_sweep(drag_ms(r)));
     }
+    write_file_atomically(table, csv);
   }
-  std::filesystem::rename(table.string() + ".tmp", table);
   std::printf("%s\n-> %s\n-> %s\n", report.note.c_str(), (docs / "tracker_filter_jitter_vs_lag.png").c_str(),
               table.c_str());
   return 0;

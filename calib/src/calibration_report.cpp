@@ -1,34 +1,20 @@
 #include "lumar/calib/calibration_report.h"
 
 #include <algorithm>
-#include <fstream>
 #include <opencv2/core/persistence.hpp>
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "lumar/base/error.h"
+#include "lumar/base/output_file.h"
+#include "lumar/calib/image_file.h"
 
 namespace lumar::calib {
 
-namespace {
-
-void rename_into_place(const std::string& tmp, const std::filesystem::path& path, const char* what) {
-  std::error_code ec;
-  std::filesystem::rename(tmp, path, ec);
-  if (ec) {
-    std::filesystem::remove(tmp, ec);
-    throw RuntimeError(path.string() + ": cannot write " + what + " (" + ec.message() + ")");
-  }
-}
-
-}  // namespace
-
 void save_calibration_report(const std::filesystem::path& path, const RobustCalibrationResult& r,
                              cv::Size board_inner_corners, double square_size_m) {
-  const auto tmp = path.string() + ".tmp";
   {
-    cv::FileStorage fs(tmp, cv::FileStorage::WRITE | cv::FileStorage::FORMAT_YAML);
-    if (!fs.isOpened()) throw RuntimeError(path.string() + ": cannot write calibration file; check the folder");
+    // Into memory first, then onto disk whole (lumar/base/output_file.h).
+    cv::FileStorage fs(".yml", cv::FileStorage::WRITE | cv::FileStorage::MEMORY | cv::FileStorage::FORMAT_YAML);
     const CameraIntrinsics& c = r.camera.intrinsics;
     fs << "nframes" << int(r.used_views.size());
     fs << "image_width" << c.width;
@@ -61,8 +47,8 @@ void save_calibration_report(const std::filesystem::path& path, const RobustCali
     fs << "holdout_splits" << r.holdout_splits;
     fs << "coverage_fraction" << r.coverage;
     fs << "board_orientations" << r.orientations;
+    write_file_atomically(path, fs.releaseAndGetString());
   }
-  rename_into_place(tmp, path, "calibration file");
 }
 
 void write_coverage_image(const std::filesystem::path& path, const BoardViews& views, const RobustCalibrationResult& r,
@@ -107,25 +93,7 @@ void write_coverage_image(const std::filesystem::path& path, const BoardViews& v
   cv::putText(img, caption, {8, size.height - 10}, cv::FONT_HERSHEY_SIMPLEX, 0.5, cv::Scalar(255, 255, 255), 1,
               cv::LINE_AA);
 
-  std::string ext = path.extension().string();
-  if (ext.empty()) ext = ".png";
-  std::vector<uchar> bytes;
-  try {
-    if (!cv::imencode(ext, img, bytes)) throw InputError("");
-  } catch (const std::exception&) {
-    throw InputError(path.string() + ": cannot encode the coverage image in this format; use a .png name");
-  }
-  const auto tmp = path.string() + ".tmp";
-  {
-    std::ofstream out(tmp, std::ios::binary);
-    out.write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size()));
-    if (!out) {
-      std::error_code ec;
-      std::filesystem::remove(tmp, ec);
-      throw RuntimeError(path.string() + ": cannot write the coverage image; check the folder");
-    }
-  }
-  rename_into_place(tmp, path, "coverage image");
+  write_image_atomically(path, img);
 }
 
 }  // namespace lumar::calib

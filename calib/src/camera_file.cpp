@@ -3,6 +3,7 @@
 #include <opencv2/core/persistence.hpp>
 
 #include "lumar/base/error.h"
+#include "lumar/base/output_file.h"
 
 namespace lumar::calib {
 
@@ -46,19 +47,14 @@ CameraFile load_camera_file(const std::filesystem::path& path) {
 }
 
 void save_camera_file(const std::filesystem::path& path, const CameraFile& camera) {
-  const auto tmp = path.string() + ".tmp";
-  {
-    cv::FileStorage fs(tmp, cv::FileStorage::WRITE | cv::FileStorage::FORMAT_YAML);
-    if (!fs.isOpened()) throw RuntimeError(path.string() + ": cannot write calibration file");
-    fs << "image_width" << camera.intrinsics.width;
-    fs << "image_height" << camera.intrinsics.height;
-    fs << "camera_matrix" << cv::Mat(camera.intrinsics.camera_matrix());
-    fs << "distortion_coefficients" << camera.intrinsics.distortion_coefficients();
-    fs << "avg_reprojection_error" << camera.avg_reprojection_error;
-  }
-  std::error_code ec;
-  std::filesystem::rename(tmp, path, ec);
-  if (ec) throw RuntimeError(path.string() + ": cannot write calibration file (" + ec.message() + ")");
+  // Into memory first, then onto disk whole (lumar/base/output_file.h).
+  cv::FileStorage fs(".yml", cv::FileStorage::WRITE | cv::FileStorage::MEMORY | cv::FileStorage::FORMAT_YAML);
+  fs << "image_width" << camera.intrinsics.width;
+  fs << "image_height" << camera.intrinsics.height;
+  fs << "camera_matrix" << cv::Mat(camera.intrinsics.camera_matrix());
+  fs << "distortion_coefficients" << camera.intrinsics.distortion_coefficients();
+  fs << "avg_reprojection_error" << camera.avg_reprojection_error;
+  write_file_atomically(path, fs.releaseAndGetString());
 }
 
 }  // namespace lumar::calib

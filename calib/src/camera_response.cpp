@@ -9,6 +9,7 @@
 
 #include "lumar/base/color.h"
 #include "lumar/base/error.h"
+#include "lumar/base/output_file.h"
 
 namespace lumar::calib {
 namespace {
@@ -149,24 +150,7 @@ void save_camera_response(const std::filesystem::path& path, const CameraRespons
   j["version"] = 1;
   j["channels"] = nlohmann::json::array();
   for (const auto& channel : response.exposure) j["channels"].push_back(channel);
-  const std::string tmp = path.string() + ".tmp";
-  {
-    std::ofstream out(tmp, std::ios::trunc);
-    out << j.dump() << '\n';
-    out.close();
-    if (!out) {
-      std::error_code ignored;
-      std::filesystem::remove(tmp, ignored);
-      throw RuntimeError(path.string() + ": cannot write camera response file; check the folder and free space");
-    }
-  }
-  std::error_code ec;
-  std::filesystem::rename(tmp, path, ec);
-  if (ec) {
-    std::error_code ignored;
-    std::filesystem::remove(tmp, ignored);
-    throw RuntimeError(path.string() + ": cannot write camera response file (" + ec.message() + ")");
-  }
+  write_file_atomically(path, j.dump() + "\n");
 }
 
 }  // namespace lumar::calib

@@ -6,13 +6,13 @@
 #include <optional>
 #include <string>
 
+#include "lumar/base/constants.h"
 #include "lumar/base/error.h"
 
 namespace lumar::calib {
 
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 constexpr int kParams = 13;  // X (rotation, translation), Z (same), offset
 
 double median(std::vector<double> v) {

@@ -3,8 +3,8 @@
 #include <string>
 
 #include "lumar/base/error.h"
+#include "lumar/base/output_file.h"
 #include "lumar/calib/board_pose.h"
-#include "lumar/capture/durable_file.h"
 #include "lumar/capture/recording_format.h"
 #include "lumar/capture/recording_reader.h"
 #include "lumar/tracking/pose_conversion.h"
@@ -121,7 +121,7 @@ void save_rig_to_session(const std::filesystem::path& dir, const RigCalibrationR
   capture::Session session = capture::session_from_json(reader.session(), file.string());
   session.rig = result.rig;
   session.extra["rig_calibration"] = rig_calibration_json(result);
-  capture::write_file_atomically(file, capture::session_to_json(session).dump(2) + "\n");
+  write_file_atomically(file, capture::session_to_json(session).dump(2) + "\n");
 }
 
 }  // namespace lumar::calib

@@ -1,7 +1,5 @@
 #include "lumar/capture/image_sequence_source.h"
 
-#include <glob.h>
-
 #include <algorithm>
 #include <charconv>
 #include <cmath>
@@ -11,6 +9,7 @@
 
 #include "csv_text.h"
 #include "lumar/base/error.h"
+#include "lumar/base/glob.h"
 
 namespace lumar::capture {
 namespace fs = std::filesystem;
@@ -31,11 +30,7 @@ std::vector<fs::path> expand(const std::string& pattern) {
     for (const auto& e : fs::directory_iterator(pattern, ec))
       if (e.is_regular_file() && is_image(e.path())) out.push_back(e.path());
   } else {
-    glob_t g{};
-    if (::glob(pattern.c_str(), 0, nullptr, &g) == 0)
-      for (std::size_t i = 0; i < g.gl_pathc; ++i)
-        if (fs::is_regular_file(g.gl_pathv[i], ec)) out.emplace_back(g.gl_pathv[i]);
-    globfree(&g);
+    return glob_files(pattern);
   }
   std::sort(out.begin(), out.end(),
             [](const fs::path& a, const fs::path& b) { return natural_less(a.string(), b.string()); });
@@ -50,32 +45,6 @@ fs::path image_folder(const std::string& pattern) {
 }
 
 }  // namespace
-
-bool natural_less(const std::string& a, const std::string& b) {
-  std::size_t i = 0, j = 0;
-  while (i < a.size() && j < b.size()) {
-    if (std::isdigit((unsigned char)a[i]) && std::isdigit((unsigned char)b[j])) {
-      std::size_t ie = i, je = j;
-      while (ie < a.size() && std::isdigit((unsigned char)a[ie])) ++ie;
-      while (je < b.size() && std::isdigit((unsigned char)b[je])) ++je;
-      // Compare as numbers without overflow: strip leading zeros, then length, then text.
-      std::size_t is = i, js = j;
-      while (is + 1 < ie && a[is] == '0') ++is;
-      while (js + 1 < je && b[js] == '0') ++js;
-      if (ie - is != je - js) return ie - is < je - js;
-      const int c = a.compare(is, ie - is, b, js, je - js);
-      if (c != 0) return c < 0;
-      if (ie - i != je - j) return ie - i < je - j;  // "01" after "1"
-      i = ie;
-      j = je;
-    } else {
-      if (a[i] != b[j]) return a[i] < b[j];
-      ++i;
-      ++j;
-    }
-  }
-  return a.size() - i < b.size() - j;
-}
 
 ImageSequenceSource::ImageSequenceSource(ImageSequenceSettings settings) : settings_(std::move(settings)) {
   const std::string& pattern = settings_.pattern;

@@ -15,7 +15,8 @@
 
 #include "csv_text.h"
 #include "lumar/base/error.h"
-#include "lumar/capture/durable_file.h"
+#include "lumar/base/output_file.h"
+#include "lumar/capture/append_file.h"
 #include "lumar/capture/tracker_raw.h"
 
 namespace lumar::capture {

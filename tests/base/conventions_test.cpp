@@ -8,11 +8,11 @@
 #include <random>
 
 #include "lumar/base/camera.h"
+#include "lumar/base/constants.h"
 #include "lumar/base/latlong.h"
 #include "lumar/base/pose.h"
 
 using namespace lumar;
-constexpr double kPi = std::numbers::pi;
 
 namespace {
 glm::dquat random_rotation(std::mt19937& rng) {

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <thread>
 
+#include "lumar/base/constants.h"
 #include "lumar/capture/frame_pose_pairing.h"
 #include "lumar/capture/recording_replay.h"
 #include "lumar/tracking/pose_conversion.h"
@@ -18,8 +19,6 @@
 
 namespace lumar::capture {
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
 
 // A smooth head-like motion of the sensor in the transmitter frame, away from the
 // Euler angles' gimbal lock.

@@ -131,15 +131,6 @@ TEST(ImageSequenceSource, GlobAtAFixedRateInNaturalOrder) {
   EXPECT_EQ(folder.files().size(), 12u);
 }
 
-TEST(ImageSequenceSource, NaturalOrder) {
-  EXPECT_TRUE(natural_less("f2.png", "f10.png"));
-  EXPECT_FALSE(natural_less("f10.png", "f2.png"));
-  EXPECT_TRUE(natural_less("a/f9", "a/f009x"));
-  EXPECT_TRUE(natural_less("f1", "f01"));
-  EXPECT_FALSE(natural_less("f1", "f1"));
-  EXPECT_TRUE(natural_less("f99999999999999999999999", "f100000000000000000000000"));
-}
-
 TEST(ImageSequenceSource, BadInputIsOneLineNamingTheFile) {
   const Sequence s = write_sequence("imgseq_bad", 3);
   test::RemoveOnSuccess cleanup{s.dir};

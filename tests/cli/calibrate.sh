@@ -26,7 +26,7 @@ case_json_summary() {
   grep -q '^std_deviations_intrinsics:' "$TMP/cam.yml" || fail "no standard deviations in the YAML"
   grep -q 'left02.jpg' "$TMP/cam.yml" || fail "rejected view not named in the YAML"
   [ "$(head -c 8 "$TMP/coverage.png" | od -An -tx1 | tr -d ' \n')" = "89504e470d0a1a0a" ] || fail "coverage is not a PNG"
-  [ ! -e "$TMP/cam.yml.tmp" ] || fail "temporary file left behind"
+  no_temporaries "$TMP"
   python3 -c "import json; j=json.load(open('$TMP/out.json')); print('ok: rms %.3f (all %.3f), rejected %s, held-out %.3f, coverage %.2f' % (j['rms'], j['initial_rms'], j['views_rejected'], j['holdout_rms'], j['coverage']))"
 }
 
@@ -43,6 +43,15 @@ case_plain_output_still_works() {
     >"$TMP/stdout" 2>"$TMP/stderr" || { cat "$TMP/stderr" >&2; fail "calibrate failed"; }
   grep -q 'RMS' "$TMP/stdout" || fail "no summary on stdout"
   grep -q '^avg_reprojection_error:' "$TMP/cam.yml" || fail "no avg_reprojection_error in the YAML"
+}
+
+case_character_classes_in_patterns() {
+  # One glob rule everywhere (glob(3)): [0-9] classes match, as in a shell.
+  "$LUMAR" calibrate --images "$BOARDS/left[0-9][0-9].jpg" --out "$TMP/cam.yml" --no-reject --json \
+    >"$TMP/out.json" 2>"$TMP/stderr" || { cat "$TMP/stderr" >&2; fail "calibrate with a character class failed"; }
+  json_check "j['views_used'] == 13"
+  expect_bad_input "left[2-9][0-9].jpg" "$TMP/none.yml" -- \
+    "$LUMAR" calibrate --images "$BOARDS/left[2-9][0-9].jpg" --out "$TMP/none.yml"
 }
 
 case_wrong_board_size() {

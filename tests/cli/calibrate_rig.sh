@@ -35,7 +35,7 @@ print('ok: offset %.2f mm %.3f deg, world %.2f mm %.3f deg, latency %+.2f ms' % 
 assert e[0] < 2 and e[1] < 0.2 and e[2] < 3 and e[3] < 0.2 and abs(e[4]) < 2, e"
   python3 -c "$check" || fail "calibrated rig is not near the truth"
   json_check "s['rig_calibration']['latency_ns'] == s['rig']['latency_ns'] and s['format'] == 'lumar-recording'"
-  [ ! -e "$TMP/rec/session.json.tmp" ] || fail "temporary session file left behind"
+  no_temporaries "$TMP/rec"
   # A second run starts from the calibrated latency: nothing left to correct.
   "$LUMAR" calibrate-rig --recording "$TMP/rec" --every 2 --dry-run --json >"$TMP/out.json" 2>"$TMP/stderr" ||
     { cat "$TMP/stderr" >&2; fail "second calibrate-rig failed"; }

@@ -159,7 +159,6 @@ open('$TMP/img/frame-000000.png','wb').write(b'\x89PNG\r\n\x1a\n'+chunk(b'IHDR',
 
 # OpenEXR magic number: the file is a whole EXR (outputs are renamed into place complete).
 is_exr() { [ "$(od -An -tx1 -N4 "$1" | tr -d ' ')" = "762f3101" ]; }
-no_leftovers() { [ -z "$(find "$TMP" -maxdepth 1 -name '*.tmp' -o -maxdepth 1 -name '.*partial*')" ]; }
 
 case_live_recording_reconstructs_the_map() {
   # A recorded sweep (20 stations of 3 exposures, 0.75 deg tracker noise) played in real
@@ -176,7 +175,7 @@ case_live_recording_reconstructs_the_map() {
   cat "$TMP/live.log"
   is_exr "$TMP/live.exr" || fail "no EXR written"
   [ -s "$TMP/live.png" ] || fail "no coverage PNG written"
-  no_leftovers || fail "temporary files left behind"
+  no_temporaries "$TMP"
   local updates first last err
   updates=$(grep -c "updated $TMP/live.exr" "$TMP/live.log")
   [ "$updates" -ge 3 ] || fail "expected the map rewritten at least 3 times while running, got $updates"
@@ -323,7 +322,7 @@ case_live_stops_cleanly_on_sigint() {
   [ -n "$frames" ] || fail "no summary line"
   [ "$frames" -lt 160 ] || fail "SIGINT did not stop the sweep early: all $frames frames were read"
   is_exr "$TMP/live.exr" || fail "no EXR after SIGINT"
-  no_leftovers || fail "temporary files left behind"
+  no_temporaries "$TMP"
 }
 
 case_live_tracker_vanishes() {

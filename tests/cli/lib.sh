@@ -39,6 +39,14 @@ expect_bad_input() {
   echo "ok: $(head -1 "$TMP/stderr")"
 }
 
+# no_temporaries DIR: nothing an output's writer leaves while it works (".NAME.partial-*",
+# or an old-style "NAME.tmp") is left in DIR.
+no_temporaries() {
+  local left
+  left=$(find "$1" -maxdepth 1 \( -name '.*partial*' -o -name '*.tmp' \) | head -3)
+  [ -z "$left" ] || fail "temporary files left behind: $left"
+}
+
 # wait_for SECONDS COMMAND...: true once COMMAND succeeds, false at the deadline.
 wait_for() {
   local deadline=$((SECONDS + $1))

@@ -31,7 +31,7 @@ case_methods_agree_and_baseline_differs() {
   for m in lines reference sphere; do
     "$LUMAR" shadows --scene "$SCENE" --query "$TMP/in.csv" --out "$TMP/$m.csv" --method $m 2>"$TMP/stderr" ||
       { cat "$TMP/stderr" >&2; fail "shadows --method $m failed"; }
-    [ ! -e "$TMP/$m.csv.tmp" ] || fail "temporary file left behind"
+    no_temporaries "$TMP"
   done
   check_csv lines.csv "len(a) == 170 and all(0 <= v <= 1 for r in a for v in r)"
   check_csv lines.csv "min(r[1] for r in a) < 0.9"    # a shadow under the figurine

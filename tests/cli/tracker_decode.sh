@@ -83,7 +83,7 @@ case_tracker_raw_chunks() {
   "$LUMAR" tracker decode "$TMP/tracker.raw" --out "$TMP/poses.csv" >"$TMP/stdout" 2>"$TMP/stderr" \
     || fail "exit status $?"
   [ ! -s "$TMP/stdout" ] || fail "--out given but CSV went to stdout"
-  [ ! -e "$TMP/poses.csv.tmp" ] || fail "temporary output left behind"
+  no_temporaries "$TMP"
   printf '%s\n' "$HEADER" "$ROW1" "$ROW2" >"$TMP/expected.csv"
   diff -u "$TMP/expected.csv" "$TMP/poses.csv" || fail "CSV differs"
   grep -qF "2 records, 0 rejected records, 0 skipped bytes, 23 bytes of a torn chunk ignored" "$TMP/stderr" \

@@ -6,6 +6,7 @@
 
 #include "../common/test_paths.h"
 #include "irradiance_test_util.h"
+#include "lumar/base/constants.h"
 #include "lumar/base/latlong.h"
 #include "lumar/lighting/irradiance_reference.h"
 #include "lumar/lighting/irradiance_volume.h"
@@ -13,8 +14,6 @@
 
 namespace lumar::test {
 namespace {
-
-constexpr double kPi = std::numbers::pi;
 
 EnvironmentMap uniform_map(int h, float value) {
   EnvironmentMap m;

@@ -7,6 +7,7 @@
 
 #include "../common/test_paths.h"
 #include "irradiance_test_util.h"
+#include "lumar/base/constants.h"
 #include "lumar/base/error.h"
 #include "lumar/base/latlong.h"
 #include "lumar/lighting/irradiance_reference.h"
@@ -14,8 +15,6 @@
 
 namespace lumar::test {
 namespace {
-
-constexpr double kPi = std::numbers::pi;
 
 struct Fixture {
   DividedRoom room = make_divided_room();

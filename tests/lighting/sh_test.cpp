@@ -12,14 +12,13 @@
 #include <random>
 
 #include "lumar/base/color.h"
+#include "lumar/base/constants.h"
 #include "lumar/base/latlong.h"
 #include "test_geometry.h"
 #include "test_paths.h"
 
 namespace lumar {
 namespace {
-
-constexpr double kPi = std::numbers::pi;
 
 // A map whose texel at map direction d is radiance(d), equal in R, G and B.
 EnvironmentMap map_from(int width, const std::function<double(const glm::dvec3&)>& radiance) {

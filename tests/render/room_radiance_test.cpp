@@ -5,6 +5,7 @@
 #include <cmath>
 #include <numbers>
 
+#include "lumar/base/constants.h"
 #include "lumar/base/error.h"
 #include "lumar/base/latlong.h"
 #include "lumar/render/renderer.h"
@@ -13,7 +14,6 @@
 namespace lumar::test {
 namespace {
 
-constexpr double kPi = std::numbers::pi;
 const glm::dvec3 kRoomMin(-2.0, 0.0, -3.0), kRoomMax(3.0, 2.6, 2.5);
 
 EnvironmentMap make_map(int width, int height, glm::dvec3 capture, double offset_deg,

@@ -6,14 +6,13 @@
 #include <numbers>
 
 #include "lumar/base/color.h"
+#include "lumar/base/constants.h"
 #include "lumar/base/latlong.h"
 #include "lumar/render/renderer.h"
 #include "render_test_util.h"
 
 namespace lumar::test {
 namespace {
-
-constexpr double kPi = std::numbers::pi;
 
 SH9 uniform_sh(double radiance) {
   SH9 sh;

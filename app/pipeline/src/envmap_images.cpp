@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "lumar/base/error.h"
+#include "lumar/base/output_file.h"
 #include "lumar/calib/camera_file.h"
 #include "lumar/calib/camera_response.h"
 #include "lumar/capture/image_sequence_source.h"
@@ -204,40 +205,31 @@ SweepInput images_sweep_input(const ImagesInputOptions& o, int width) {
 
 void export_sweep_images(const SweepInput& in, const std::string& dir_text) {
   const fs::path dir = dir_text;
-  std::error_code ec;
-  if (fs::exists(dir, ec)) throw InputError(dir_text + ": already exists; --export-images makes a new folder");
-  const fs::path tmp = dir.string() + ".partial";
-  fs::remove_all(tmp, ec);
-  fs::create_directories(tmp, ec);
-  if (ec) throw InputError(dir_text + ": cannot create the folder (" + ec.message() + ")");
-  try {
-    std::ofstream csv(tmp / "poses.csv");
-    csv.precision(12);
-    csv << "file,qw,qx,qy,qz,x,y,z,exposure" << (in.groups.empty() ? "" : ",station") << '\n';
-    const glm::dvec3 p = in.stitch.capture_position;
-    Progress progress("exporting", int(in.rotations.size()));
-    int done = 0;
-    in.read_frames([&](const cv::Mat& image, int k) {
-      char name[32];
-      std::snprintf(name, sizeof name, "frame-%06d.png", k);
-      if (!cv::imwrite((tmp / name).string(), image)) throw InputError((dir / name).string() + ": cannot write");
-      const glm::dquat& q = in.rotations[k];
-      csv << name << ',' << q.w << ',' << q.x << ',' << q.y << ',' << q.z << ',' << p.x << ',' << p.y << ',' << p.z
-          << ',' << in.exposures[k];
-      if (!in.groups.empty()) csv << ',' << in.groups[k];
-      csv << '\n';
-      progress.update(++done);
-    });
-    if (!csv) throw InputError(dir_text + ": cannot write poses.csv; check the disk");
-    calib::CameraFile camera;
-    camera.intrinsics = in.stitch.camera;
-    calib::save_camera_file(tmp / "camera.yml", camera);
-    if (done != int(in.rotations.size())) throw InputError(in.name + ": not every frame could be read");
-  } catch (...) {
-    fs::remove_all(tmp, ec);
-    throw;
-  }
-  fs::rename(tmp, dir);
+  OutputFolder folder(dir);  // InputError when it exists: --export-images makes a new folder
+  const fs::path& tmp = folder.temporary();
+  std::ostringstream csv;
+  csv.precision(12);
+  csv << "file,qw,qx,qy,qz,x,y,z,exposure" << (in.groups.empty() ? "" : ",station") << '\n';
+  const glm::dvec3 p = in.stitch.capture_position;
+  Progress progress("exporting", int(in.rotations.size()));
+  int done = 0;
+  in.read_frames([&](const cv::Mat& image, int k) {
+    char name[32];
+    std::snprintf(name, sizeof name, "frame-%06d.png", k);
+    if (!cv::imwrite((tmp / name).string(), image)) throw RuntimeError((dir / name).string() + ": cannot write");
+    const glm::dquat& q = in.rotations[k];
+    csv << name << ',' << q.w << ',' << q.x << ',' << q.y << ',' << q.z << ',' << p.x << ',' << p.y << ',' << p.z << ','
+        << in.exposures[k];
+    if (!in.groups.empty()) csv << ',' << in.groups[k];
+    csv << '\n';
+    progress.update(++done);
+  });
+  if (done != int(in.rotations.size())) throw InputError(in.name + ": not every frame could be read");
+  write_file_atomically(tmp / "poses.csv", csv.str());
+  calib::CameraFile camera;
+  camera.intrinsics = in.stitch.camera;
+  calib::save_camera_file(tmp / "camera.yml", camera);
+  folder.commit();
   spdlog::info(
       "envmap: stitch them with: lumar envmap --images {0} --poses {0}/poses.csv --camera {0}/camera.yml "
       "--vignetting {1} --vignetting-b {2} --out OUT.exr (and the recording's camera response, if not sRGB)",

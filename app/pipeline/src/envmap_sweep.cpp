@@ -7,10 +7,12 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <fstream>
+#include <sstream>
 
 #include "lumar/base/error.h"
+#include "lumar/base/output_file.h"
 #include "lumar/base/pose.h"
+#include "lumar/calib/image_file.h"
 #include "lumar/envmap/envmap_quality.h"
 #include "lumar/envmap/hole_filling.h"
 #include "lumar/envmap/orientation_refinement.h"
@@ -65,20 +67,16 @@ double write_envmap_outputs(EnvironmentMap map, const cv::Mat& coverage, const E
 
 namespace {
 
-void write_corrections(const SweepInput& in, const calib::RefinementResult& result, const std::string& path_text) {
-  const std::filesystem::path path = path_text, tmp = path.string() + ".tmp";
-  {
-    std::ofstream out(tmp);
-    out << in.label_header << ",correction_deg,qw,qx,qy,qz\n";
-    out.precision(12);
-    for (std::size_t k = 0; k < result.rotations.size(); ++k) {
-      const glm::dquat& q = result.rotations[k];
-      out << in.labels[k] << ',' << result.correction_deg[k] << ',' << q.w << ',' << q.x << ',' << q.y << ',' << q.z
-          << '\n';
-    }
-    if (!out) throw InputError(path_text + ": cannot write the corrections; check the folder");
+void write_corrections(const SweepInput& in, const calib::RefinementResult& result, const std::string& path) {
+  std::ostringstream out;
+  out << in.label_header << ",correction_deg,qw,qx,qy,qz\n";
+  out.precision(12);
+  for (std::size_t k = 0; k < result.rotations.size(); ++k) {
+    const glm::dquat& q = result.rotations[k];
+    out << in.labels[k] << ',' << result.correction_deg[k] << ',' << q.w << ',' << q.x << ',' << q.y << ',' << q.z
+        << '\n';
   }
-  std::filesystem::rename(tmp, path);
+  write_file_atomically(path, out.str());
 }
 
 }  // namespace

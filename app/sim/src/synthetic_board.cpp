@@ -6,6 +6,7 @@
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "lumar/base/constants.h"
 #include "lumar/base/error.h"
 #include "lumar/capture/recording_writer.h"
 #include "lumar/capture/session.h"
@@ -17,7 +18,6 @@ namespace lumar::app {
 
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 constexpr double kBlack = 30, kWhite = 220, kBackground = 110;
 
 // Integral of the square wave that is +1 on [2k s, (2k+1) s) and -1 elsewhere: a

@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "lumar/base/color.h"
+#include "lumar/base/constants.h"
 #include "lumar/base/error.h"
 #include "lumar/base/latlong.h"
 
@@ -71,7 +72,7 @@ glm::dvec3 irradiance_direct(const EnvironmentMap& map, const glm::dvec3& world_
 
 std::vector<glm::dvec3> fibonacci_directions(int count) {
   std::vector<glm::dvec3> out;
-  const double golden = 3.14159265358979323846 * (3.0 - std::sqrt(5.0));
+  const double golden = kPi * (3.0 - std::sqrt(5.0));
   for (int k = 0; k < count; ++k) {
     const double y = 1.0 - 2.0 * (k + 0.5) / count, r = std::sqrt(std::max(0.0, 1.0 - y * y));
     out.emplace_back(r * std::cos(golden * k), y, r * std::sin(golden * k));

@@ -6,14 +6,13 @@
 #include <cmath>
 #include <opencv2/calib3d.hpp>
 
+#include "lumar/base/constants.h"
 #include "lumar/base/error.h"
 #include "lumar/base/latlong.h"
 
 namespace lumar::calib {
 
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
 
 // The largest squared normalised radius (x/z, y/z) of any ray through the image,
 // sampled along the border of the pixel area (distortion is radial-dominant, so the

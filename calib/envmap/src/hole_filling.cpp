@@ -147,25 +147,4 @@ cv::Mat contact_sheet(const EnvironmentMap& map, const cv::Mat& count) {
   return sheet;
 }
 
-void write_image_atomically(const std::filesystem::path& path, const cv::Mat& image) {
-  const std::filesystem::path tmp =
-      path.parent_path() / ("." + path.filename().string() + ".partial" + path.extension().string());
-  bool ok = false;
-  try {
-    ok = cv::imwrite(tmp.string(), image);
-  } catch (const cv::Exception&) {
-    ok = false;
-  }
-  std::error_code ec;
-  if (!ok) {
-    std::filesystem::remove(tmp, ec);
-    throw InputError(path.string() + ": cannot write image; check the folder exists and the extension (.png)");
-  }
-  std::filesystem::rename(tmp, path, ec);
-  if (ec) {
-    std::filesystem::remove(tmp, ec);
-    throw InputError(path.string() + ": cannot write image (" + ec.message() + ")");
-  }
-}
-
 }  // namespace lumar::calib

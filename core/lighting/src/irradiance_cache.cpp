@@ -7,6 +7,7 @@
 #include <fstream>
 
 #include "lumar/base/error.h"
+#include "lumar/base/output_file.h"
 #include "lumar/lighting/irradiance_volume.h"
 
 namespace lumar {
@@ -73,9 +74,10 @@ struct Fnv {
 }  // namespace
 
 void IrradianceVolume::save(const std::filesystem::path& file) const {
-  const std::string name = file.string(), tmp = name + ".tmp";
+  const std::string name = file.string();
+  OutputFile output(file);
   {
-    Writer w{std::ofstream(tmp, std::ios::binary | std::ios::trunc)};
+    Writer w{std::ofstream(output.temporary(), std::ios::binary | std::ios::trunc)};
     if (!w.out) throw RuntimeError(name + ": cannot write the irradiance volume; check the folder's permissions");
     w.out.write(kMagic, sizeof(kMagic));
     VolumeSettings s = settings_;
@@ -88,19 +90,10 @@ void IrradianceVolume::save(const std::filesystem::path& file) const {
     w.vector(irradiance_atlas), w.vector(depth_atlas), w.vector(sh), w.vector(lights), w.vector(light_visibility);
     w.value(capture_position), w.value(normal_bias);
     w.value(shadow_n), w.vector(light_shadow);
-    w.out.flush();
-    if (!w.out) {
-      std::error_code ignored;
-      std::filesystem::remove(tmp, ignored);
-      throw RuntimeError(name + ": cannot write the irradiance volume (disk full?)");
-    }
+    w.out.close();
+    if (!w.out) throw RuntimeError(name + ": cannot write the irradiance volume (disk full?)");
   }
-  std::error_code ec;
-  std::filesystem::rename(tmp, file, ec);
-  if (ec) {
-    std::filesystem::remove(tmp, ec);
-    throw RuntimeError(name + ": cannot write the irradiance volume (" + ec.message() + ")");
-  }
+  output.commit();
 }
 
 IrradianceVolume IrradianceVolume::load(const std::filesystem::path& file) {

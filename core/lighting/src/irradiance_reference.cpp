@@ -7,12 +7,12 @@
 #include <numbers>
 #include <random>
 
+#include "lumar/base/constants.h"
 #include "lumar/base/latlong.h"
 
 namespace lumar {
 
 namespace {
-constexpr double kPi = std::numbers::pi;
 
 // An orthonormal frame around n (Duff et al. 2017).
 void basis(const glm::dvec3& n, glm::dvec3& t, glm::dvec3& b) {

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <numbers>
 
+#include "lumar/base/constants.h"
 #include "lumar/base/error.h"
 #include "lumar/base/latlong.h"
 #include "lumar/base/octahedral.h"
@@ -16,7 +17,6 @@ namespace lumar {
 
 namespace {
 
-constexpr double kPi = std::numbers::pi;
 constexpr double kDepthSharpness = 20.0;  // cosine power that spreads ray distances over moment texels
 constexpr int kShadowResolution = 128;    // light shadow maps: ~1.4 degrees per texel
 

@@ -6,13 +6,13 @@
 #include <numbers>
 #include <numeric>
 
+#include "lumar/base/constants.h"
 #include "lumar/base/error.h"
 #include "lumar/base/latlong.h"
 
 namespace lumar {
 
 namespace {
-constexpr double kPi = std::numbers::pi;
 
 // Where the map's texels along `t.direction` came from: the proxy point the capture point
 // sees that way (a BrightTexel or a DominantLight). Left at infinity if the ray escapes.

@@ -6,13 +6,13 @@
 #include <numbers>
 #include <vector>
 
+#include "lumar/base/constants.h"
 #include "lumar/base/latlong.h"
 
 namespace lumar {
 
 namespace {
 
-constexpr double kPi = std::numbers::pi;
 // Basis constants and R&H's c1..c5 in full double precision (R&H print them to six
 // digits: 0.282095, 0.488603, 1.092548, 0.315392, 0.546274; c1 = 0.429043,
 // c2 = 0.511664, c3 = 0.743125, c4 = 0.886227, c5 = 0.247708). Rounded constants

@@ -8,6 +8,7 @@
 #include "lumar/base/color.h"
 #include "lumar/base/error.h"
 #include "lumar/base/latlong.h"
+#include "lumar/base/output_file.h"
 
 namespace lumar {
 
@@ -101,27 +102,20 @@ void save_environment_map(const std::filesystem::path& path, const EnvironmentMa
   const std::string name = path.string();
   if (map.width <= 0 || map.height <= 0 || map.rgb.size() != std::size_t(map.width) * map.height * 3)
     throw RuntimeError(name + ": cannot save an environment map whose pixel buffer does not match its size");
-  // The temporary name does not end in .exr, so name the format explicitly.
-  const std::string tmp = name + ".tmp";
+  OutputFile file(path);
+  // Always OpenEXR, whatever the name ends in.
   auto out = OIIO::ImageOutput::create("openexr");
   if (!out) throw RuntimeError(name + ": OpenImageIO has no OpenEXR writer (" + OIIO::geterror() + ")");
   OIIO::ImageSpec spec(map.width, map.height, 3, OIIO::TypeDesc::FLOAT);
   spec.attribute("compression", "zip");
-  const bool ok = out->open(tmp, spec) && out->write_image(OIIO::TypeDesc::FLOAT, map.rgb.data()) && out->close();
+  const bool ok = out->open(file.temporary().string(), spec) &&
+                  out->write_image(OIIO::TypeDesc::FLOAT, map.rgb.data()) && out->close();
   if (!ok) {
     std::string why = out->geterror();
     std::replace(why.begin(), why.end(), '\n', ' ');
-    std::error_code ignored;
-    std::filesystem::remove(tmp, ignored);
     throw RuntimeError(name + ": cannot write environment map (" + why + "); check the folder and free space");
   }
-  std::error_code ec;
-  std::filesystem::rename(tmp, path, ec);
-  if (ec) {
-    std::error_code ignored;
-    std::filesystem::remove(tmp, ignored);
-    throw RuntimeError(name + ": cannot write environment map (" + ec.message() + ")");
-  }
+  file.commit();
 }
 
 }  // namespace lumar

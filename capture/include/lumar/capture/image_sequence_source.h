@@ -50,7 +50,4 @@ class ImageSequenceSource final : public FrameSource {
   std::size_t next_ = 0;
 };
 
-// a < b in natural order: runs of digits compare as numbers ("f2" < "f10").
-bool natural_less(const std::string& a, const std::string& b);
-
 }  // namespace lumar::capture

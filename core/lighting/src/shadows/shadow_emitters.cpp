@@ -1,11 +1,12 @@
 #include "lumar/lighting/shadows/shadow_emitters.h"
-#include "lumar/base/color.h"
 
 #include <algorithm>
 #include <cmath>
 #include <numeric>
 #include <queue>
 
+#include "lumar/base/color.h"
+#include "lumar/base/constants.h"
 #include "lumar/base/error.h"
 #include "lumar/base/latlong.h"
 
@@ -184,7 +185,7 @@ Emitters build_emitters(const EnvironmentMap& map, const RayScene& proxy, bool d
   for (int r = 0; r < H; ++r)
     for (int c = 0; c < W; ++c)
       mean_lum += latlong_pixel_solid_angle(r, W, H) * luminance(radiance[std::size_t(r) * W + c]);
-  mean_lum /= 4.0 * 3.14159265358979;
+  mean_lum /= 4.0 * kPi;
   const double threshold = options.threshold_over_mean * mean_lum;
 
   Emitters out;
@@ -227,7 +228,7 @@ Emitters build_emitters(const EnvironmentMap& map, const RayScene& proxy, bool d
   const Clustering clustering(out.texels, distant, receiver_centre, receiver_normal);
   std::vector<std::uint32_t> all(out.texels.size());
   std::iota(all.begin(), all.end(), 0u);
-  const double resolved_angle = options.resolved_angle_deg * 3.14159265358979 / 180.0;
+  const double resolved_angle = options.resolved_angle_deg * kPi / 180.0;
   const auto resolved_share = [&](const std::vector<Clustering::Cluster>& cs) {
     double total = 0, resolved = 0;
     for (const auto& c : cs) {

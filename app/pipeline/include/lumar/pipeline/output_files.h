@@ -1,11 +1,13 @@
 #pragma once
-// Outputs that appear whole or not at all: everything is written under a temporary
-// name and renamed into place by commit(); without commit() the partial output is removed.
+// The overlay's outputs, whole or not at all (lumar/base/output_file.h): a video, a
+// folder of PNG frames, a contact sheet.
 #include <filesystem>
 #include <opencv2/core.hpp>
 #include <opencv2/videoio.hpp>
 #include <utility>
 #include <vector>
+
+#include "lumar/base/output_file.h"
 
 namespace lumar::app {
 
@@ -18,22 +20,19 @@ class VideoOutput {
   const std::string& codec() const { return codec_; }
 
  private:
-  std::filesystem::path path_, partial_;
+  OutputFile file_;
   cv::VideoWriter writer_;
   std::string codec_;
-  bool committed_ = false;
 };
 
 class FramesOutput {
  public:
-  explicit FramesOutput(std::filesystem::path dir);  // the folder must not exist yet
-  ~FramesOutput();
+  explicit FramesOutput(std::filesystem::path dir);     // the folder must not exist yet
   void write(std::int64_t index, const cv::Mat& bgr8);  // frame-000123.png
   void commit();
 
  private:
-  std::filesystem::path dir_, partial_;
-  bool committed_ = false;
+  OutputFolder folder_;
 };
 
 // Tiles frames (each scaled to `tile_width`, aspect kept) into rows of `columns`, with

@@ -24,8 +24,4 @@ cv::Mat coverage_image(const cv::Mat& coverage_count);
 // sRGB 8-bit (CV_8UC3, BGR). With a non-empty coverage count, filled holes are hatched.
 cv::Mat contact_sheet(const EnvironmentMap& map, const cv::Mat& coverage_count = cv::Mat());
 
-// Writes an 8-bit image (PNG by extension) atomically; throws InputError naming the file
-// when it cannot be written.
-void write_image_atomically(const std::filesystem::path& path, const cv::Mat& image);
-
 }  // namespace lumar::calib

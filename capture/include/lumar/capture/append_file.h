@@ -1,21 +1,12 @@
 #pragma once
-// Files that a crash cannot tear. Whole files are replaced by rename, so a reader
-// sees the old or the new contents, never a mix. Logs are append-only: what was
-// flushed survives kill -9, what was synced also survives a power cut, and a
-// reader only has to ignore a torn tail.
+// Logs that a crash cannot tear: append-only files. What was flushed survives kill -9,
+// what was synced also survives a power cut, and a reader only has to ignore a torn
+// tail. (Whole files are replaced atomically instead: lumar/base/output_file.h.)
 #include <filesystem>
 #include <string>
 #include <string_view>
 
 namespace lumar::capture {
-
-// Writes "<path>.tmp", fsyncs it, renames it over `path`, fsyncs the directory.
-// Throws RuntimeError naming the file on failure (no half-written `path` is left).
-void write_file_atomically(const std::filesystem::path& path, std::string_view contents);
-
-// fsync of a file or a directory (a directory must be synced to make a rename or a
-// new entry durable). Throws RuntimeError naming it on failure.
-void fsync_path(const std::filesystem::path& path);
 
 // An append-only file with its own buffer. append() only queues bytes; flush()
 // hands them to the kernel in one go (so the file only ever grows by whole

@@ -1,4 +1,4 @@
-#include "lumar/capture/durable_file.h"
+#include "lumar/capture/append_file.h"
 
 #include <fcntl.h>
 #include <unistd.h>
@@ -19,50 +19,7 @@ constexpr std::size_t kAutoFlushBytes = 1 << 20;
                      "); check free space and permissions");
 }
 
-void write_all(int fd, std::string_view bytes, const std::filesystem::path& path) {
-  while (!bytes.empty()) {
-    const ssize_t n = ::write(fd, bytes.data(), bytes.size());
-    if (n < 0) {
-      if (errno == EINTR) continue;
-      fail(path, "write", errno);
-    }
-    bytes.remove_prefix(std::size_t(n));
-  }
-}
-
 }  // namespace
-
-void fsync_path(const std::filesystem::path& path) {
-  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
-  if (fd < 0) fail(path, "open for fsync", errno);
-  const int rc = ::fsync(fd);
-  const int err = errno;
-  ::close(fd);
-  if (rc != 0) fail(path, "fsync", err);
-}
-
-void write_file_atomically(const std::filesystem::path& path, std::string_view contents) {
-  std::filesystem::path tmp = path;
-  tmp += ".tmp";
-  const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
-  if (fd < 0) fail(tmp, "create", errno);
-  try {
-    write_all(fd, contents, tmp);
-    if (::fsync(fd) != 0) fail(tmp, "fsync", errno);
-  } catch (...) {
-    ::close(fd);
-    ::unlink(tmp.c_str());
-    throw;
-  }
-  if (::close(fd) != 0) fail(tmp, "close", errno);
-  if (::rename(tmp.c_str(), path.c_str()) != 0) {
-    const int err = errno;
-    ::unlink(tmp.c_str());
-    fail(path, "replace", err);
-  }
-  const auto dir = path.has_parent_path() ? path.parent_path() : std::filesystem::path(".");
-  fsync_path(dir);
-}
 
 AppendFile::AppendFile(const std::filesystem::path& path) : path_(path) {
   fd_ = ::open(path.c_str(), O_WRONLY | O_CREAT | O_APPEND | O_CLOEXEC, 0644);
