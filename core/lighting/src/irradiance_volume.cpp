@@ -31,22 +31,6 @@ std::vector<glm::dvec3> fibonacci_directions(int count) {
   return out;
 }
 
-// Real SH basis in lighting/src/sh.cpp's order (L00, L1-1 y, L10 z, L11 x, L2-2 xy, L2-1 yz,
-// L20 3z²−1, L21 xz, L22 x²−y²), so sh9_irradiance evaluates what is projected here.
-std::array<double, 9> sh_basis(const glm::dvec3& d) {
-  const double y00 = 0.5 / std::sqrt(kPi), y1 = std::sqrt(3.0 / (4.0 * kPi));
-  const double y2 = 0.5 * std::sqrt(15.0 / kPi), y20 = 0.25 * std::sqrt(5.0 / kPi), y22 = 0.25 * std::sqrt(15.0 / kPi);
-  return {y00,
-          y1 * d.y,
-          y1 * d.z,
-          y1 * d.x,
-          y2 * d.x * d.y,
-          y2 * d.y * d.z,
-          y20 * (3.0 * d.z * d.z - 1.0),
-          y2 * d.x * d.z,
-          y22 * (d.x * d.x - d.y * d.y)};
-}
-
 struct Contribution {
   glm::dvec3 direction;
   glm::dvec3 power;  // radiance x solid angle
@@ -279,7 +263,7 @@ struct ProbeBuilder {
     if (settings.storage != ProbeStorage::octahedral) {
       std::array<glm::dvec3, 9> coefficients{};
       for (const Contribution& c : contributions) {
-        const auto y = sh_basis(c.direction);
+        const auto y = sh9_basis(c.direction);
         for (int i = 0; i < 9; ++i) coefficients[std::size_t(i)] += c.power * y[std::size_t(i)];
       }
       for (int i = 0; i < 9; ++i)

@@ -29,10 +29,8 @@ const double c3 = kPi / 4.0 * 3.0 * kY20;
 const double c4 = kPi * kY00;
 const double c5 = kPi / 4.0 * kY20;
 
-// Real SH basis, bands 0..2, in the order 0 = L00, 1 = L1-1 (y), 2 = L10 (z),
-// 3 = L11 (x), 4 = L2-2 (xy), 5 = L2-1 (yz), 6 = L20 (3z^2 - 1), 7 = L21 (xz),
-// 8 = L22 (x^2 - y^2), with x, y, z the world axes as they are (+Y up). The GPU
-// shader evaluates the same order; keep them in step.
+}  // namespace
+
 std::array<double, 9> sh9_basis(const glm::dvec3& d) {
   const double x = d.x, y = d.y, z = d.z;
   return {kY00,
@@ -45,8 +43,6 @@ std::array<double, 9> sh9_basis(const glm::dvec3& d) {
           kY2_offdiagonal * x * z,
           kY22 * (x * x - y * y)};
 }
-
-}  // namespace
 
 SH9 project_radiance_sh9(const EnvironmentMap& map) {
   // One partial sum per row, added in row order afterwards, so the result does not

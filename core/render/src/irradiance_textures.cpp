@@ -45,6 +45,15 @@ vec4 volume_sample_block(sampler2D atlas, int n, int probe, vec2 e) {
   return mix(mix(a, c, f.x), mix(d, g, f.x), f.y);
 }
 
+// Ramamoorthi & Hanrahan 2001, eq. 13: irradiance at world normal n from nine SH
+// coefficients in sh9_basis's order (lighting/sh.h); the shaded-object shader uses it too.
+vec3 sh9_irradiance(vec3 L0, vec3 L1, vec3 L2, vec3 L3, vec3 L4, vec3 L5, vec3 L6, vec3 L7, vec3 L8, vec3 n) {
+  const float c1 = 0.429043, c2 = 0.511664, c3 = 0.743125, c4 = 0.886227, c5 = 0.247708;
+  float x = n.x, y = n.y, z = n.z;
+  return c1 * L8 * (x * x - y * y) + c3 * L6 * z * z + c4 * L0 - c5 * L6 +
+         2.0 * c1 * (L4 * x * y + L7 * x * z + L5 * y * z) + 2.0 * c2 * (L3 * x + L1 * y + L2 * z);
+}
+
 vec3 volume_probe_irradiance(int k, vec3 n) {
   vec3 e = vec3(0.0);
   if (volume_storage != 1) {
@@ -53,10 +62,7 @@ vec3 volume_probe_irradiance(int k, vec3 n) {
     vec3 L0 = texelFetch(volume_sh, b).rgb, L1 = texelFetch(volume_sh, b + 1).rgb, L2 = texelFetch(volume_sh, b + 2).rgb;
     vec3 L3 = texelFetch(volume_sh, b + 3).rgb, L4 = texelFetch(volume_sh, b + 4).rgb, L5 = texelFetch(volume_sh, b + 5).rgb;
     vec3 L6 = texelFetch(volume_sh, b + 6).rgb, L7 = texelFetch(volume_sh, b + 7).rgb, L8 = texelFetch(volume_sh, b + 8).rgb;
-    const float c1 = 0.429043, c2 = 0.511664, c3 = 0.743125, c4 = 0.886227, c5 = 0.247708;
-    float x = n.x, y = n.y, z = n.z;
-    e = c1 * L8 * (x * x - y * y) + c3 * L6 * z * z + c4 * L0 - c5 * L6 +
-        2.0 * c1 * (L4 * x * y + L7 * x * z + L5 * y * z) + 2.0 * c2 * (L3 * x + L1 * y + L2 * z);
+    e = sh9_irradiance(L0, L1, L2, L3, L4, L5, L6, L7, L8, n);
   }
   if (volume_storage != 0)
     e += volume_sample_block(volume_irradiance_atlas, volume_irradiance_n, k, volume_oct_encode(n)).rgb;

@@ -86,16 +86,10 @@ uniform float exposure;
 uniform vec3 sh[9];  // L00, L1-1, L10, L11, L2-2, L2-1, L20, L21, L22 (world frame)
 uniform bool use_volume;  // irradiance volume (gl/irradiance_textures.cpp) instead of sh
 vec3 volume_irradiance(vec3 p, vec3 n);
+vec3 sh9_irradiance(vec3 L0, vec3 L1, vec3 L2, vec3 L3, vec3 L4, vec3 L5, vec3 L6, vec3 L7, vec3 L8, vec3 n);
 out vec4 color;
 
-// Ramamoorthi & Hanrahan 2001, eq. 13, with the world normal's x, y, z.
-vec3 sh_irradiance(vec3 n) {
-  const float c1 = 0.429043, c2 = 0.511664, c3 = 0.743125, c4 = 0.886227, c5 = 0.247708;
-  float x = n.x, y = n.y, z = n.z;
-  return c1 * sh[8] * (x * x - y * y) + c3 * sh[6] * z * z + c4 * sh[0] - c5 * sh[6] +
-         2.0 * c1 * (sh[4] * x * y + sh[7] * x * z + sh[5] * y * z) +
-         2.0 * c2 * (sh[3] * x + sh[1] * y + sh[2] * z);
-}
+vec3 sh_irradiance(vec3 n) { return sh9_irradiance(sh[0], sh[1], sh[2], sh[3], sh[4], sh[5], sh[6], sh[7], sh[8], n); }
 
 void main() {
   vec3 n = normalize(world_normal);
