@@ -31,9 +31,8 @@
 #include "lumar/base/output_file.h"
 #include "lumar/tracking/one_euro_filter.h"
 #include "lumar/tracking/pose_conversion.h"
-#include "lumar/tracking/record_parser.h"
 #include "lumar/tracking/simulated_tracker.h"
-#include "lumar/tracking/timestamping.h"
+#include "lumar/tracking/tracker_stream.h"
 
 using namespace lumar;
 using namespace lumar::tracking;
@@ -73,16 +72,9 @@ std::vector<PoseSample> tracker_samples(const std::function<Pose(Nanos)>& truth,
   SimulatedTrackerSettings s;  // 60 Hz, 115200 baud, 0.75 deg, 2.5 mm, list 2,4,1
   s.seed = seed;
   const auto sim = simulate_tracker(truth, seconds_to_nanos(seconds), s);
-  RecordParser parser(TrackerFormat::of(Device::Isotrak2, false, s.format), s.baud);
-  std::vector<PoseSample> out;
-  for (const auto& chunk : sim.chunks) {
-    parser.push(chunk);
-    for (const auto& r : parser.take_all()) {
-      const Nanos t = measurement_time(r.first_byte_arrival, s.baud, s.device_latency);
-      if (auto sample = to_pose_sample(r.record, s.format, t)) out.push_back(*sample);
-    }
-  }
-  return out;
+  return decode_tracker_stream(sim.chunks, TrackerFormat::of(Device::Isotrak2, false, s.format), s.baud,
+                               s.device_latency)
+      .samples;
 }
 
 std::vector<PoseSample> filtered(const std::vector<PoseSample>& in, const PoseFilterSettings* settings) {

@@ -6,11 +6,7 @@
 #include "lumar/base/output_file.h"
 #include "lumar/calib/board_pose.h"
 #include "lumar/capture/recording_format.h"
-#include "lumar/capture/recording_reader.h"
-#include "lumar/tracking/pose_conversion.h"
-#include "lumar/tracking/record_codec.h"
-#include "lumar/tracking/record_parser.h"
-#include "lumar/tracking/timestamping.h"
+#include "lumar/capture/recording_replay.h"
 
 namespace lumar::calib {
 
@@ -28,46 +24,24 @@ RigRecording load_rig_recording(const std::filesystem::path& dir, cv::Size inner
   if (every < 1) throw InputError("--every: must be 1 or more");
   if (!std::filesystem::is_directory(dir))
     throw InputError(dir.string() + ": recording not found; give a recording directory");
-  const capture::RecordingReader reader(dir);
+  // Frames and tracker stream as a replay sees them (the raw bytes through the real parser).
+  const capture::RecordingReplay replay(dir);
   const std::string session_file = (dir / capture::kSessionFile).string();
   RigRecording out;
-  out.session = capture::session_from_json(reader.session(), session_file);
+  out.session = replay.session();
   out.camera = camera ? *camera : out.session.camera;
-  const cv::Size video_size = reader.video().size;
+  const cv::Size video_size = replay.reader().video().size;
   if (!video_size.empty() && (video_size.width != out.camera.width || video_size.height != out.camera.height))
     throw InputError(session_file + ": video is " + size_text(video_size) + " but the camera calibration is " +
                      std::to_string(out.camera.width) + "x" + std::to_string(out.camera.height) +
                      "; use the calibration of this camera mode");
-
-  // Tracker: the raw bytes through the real parser, as capture::RecordingReplay does.
-  const capture::TrackerSettings& t = out.session.tracker;
-  if (t.encoding != "ascii" && t.encoding != "binary")
-    throw InputError(session_file + ": tracker encoding '" + t.encoding + "' is unknown; use ascii or binary");
-  tracking::TrackerFormat format;
-  try {
-    format = tracking::TrackerFormat::of(tracking::parse_device(t.device), t.encoding == "binary",
-                                         {t.output_list, t.centimetres});
-    tracking::validate_tracker_format(format);
-  } catch (const InputError& e) {
-    throw InputError(session_file + ": " + e.what());
-  }
-  tracking::RecordParser parser(format, t.baud);
-  for (const auto& chunk : reader.tracker_chunks()) {
-    parser.push(chunk);
-    for (const auto& r : parser.take_all()) {
-      if (r.record.station != t.station) continue;
-      const Nanos time = tracking::measurement_time(r.first_byte_arrival, t.baud, out.session.rig.latency);
-      if (auto sample = tracking::to_pose_sample(r.record, format.output, time)) {
-        out.tracker.add(*sample);
-        ++out.tracker_records;
-      }
-    }
-  }
+  out.tracker = replay.sensor_poses();
+  out.tracker_records = out.tracker.size();
   if (out.tracker_records == 0)
     throw InputError((dir / capture::kTrackerFile).string() + ": no tracker records for station " +
-                     std::to_string(t.station) + "; record the tracker while filming the board");
+                     std::to_string(out.session.tracker.station) + "; record the tracker while filming the board");
 
-  auto frames = reader.open_frames();
+  auto frames = replay.open_frames();
   capture::Frame frame;
   while (frames->read(frame)) {
     if (out.frames++ % every != 0) continue;

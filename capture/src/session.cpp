@@ -108,6 +108,19 @@ Session parse_session(const json& j, const std::string& file) {
 
 }  // namespace
 
+tracking::TrackerFormat tracker_format_of(const TrackerSettings& t, const std::string& file) {
+  if (t.encoding != "ascii" && t.encoding != "binary")
+    throw InputError(file + ": tracker encoding '" + t.encoding + "' is unknown; use ascii or binary");
+  try {
+    const auto format = tracking::TrackerFormat::of(tracking::parse_device(t.device), t.encoding == "binary",
+                                                    {t.output_list, t.centimetres});
+    tracking::validate_tracker_format(format);
+    return format;
+  } catch (const InputError& e) {
+    throw InputError(file + ": " + e.what());
+  }
+}
+
 Session session_from_json(const json& j, const std::string& file) {
   try {
     return parse_session(j, file);

@@ -16,10 +16,8 @@
 #include "lumar/scene/mesh.h"
 #include "lumar/scene/scene.h"
 #include "lumar/sim/envmap_view.h"
-#include "lumar/tracking/isotrak_ascii.h"
-#include "lumar/tracking/pose_conversion.h"
 #include "lumar/tracking/simulated_tracker.h"
-#include "lumar/tracking/timestamping.h"
+#include "lumar/tracking/tracker_stream.h"
 
 namespace lumar::app {
 
@@ -51,17 +49,10 @@ tracking::SimulatedTrackerOutput simulate_session_tracker(const capture::Session
 
 void write_tracker_stream(capture::RecordingWriter& writer, const tracking::SimulatedTrackerOutput& tracker,
                           const capture::TrackerSettings& settings, Nanos assumed_latency) {
-  tracking::OutputFormat format;
-  format.output_list = settings.output_list;
-  tracking::AsciiRecordParser parser(format, 2, settings.baud);
-  for (const auto& chunk : tracker.chunks) {
-    writer.add_tracker_bytes(chunk);
-    parser.push(chunk);
-    for (const auto& r : parser.take_all()) {
-      const Nanos t = tracking::measurement_time(r.first_byte_arrival, settings.baud, assumed_latency);
-      if (auto sample = tracking::to_pose_sample(r.record, format, t)) writer.add_pose(*sample);
-    }
-  }
+  for (const auto& chunk : tracker.chunks) writer.add_tracker_bytes(chunk);
+  const auto decoded = tracking::decode_tracker_stream(tracker.chunks, capture::tracker_format_of(settings, "synth"),
+                                                       settings.baud, assumed_latency);
+  for (const auto& sample : decoded.samples) writer.add_pose(sample);
 }
 
 void write_synthetic_recording(const std::filesystem::path& out, const capture::Session& session,

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "lumar/base/camera.h"
+#include "lumar/tracking/record_codec.h"
 #include "lumar/tracking/rig.h"
 
 namespace lumar::capture {
@@ -37,6 +38,10 @@ struct Session {
   std::string scene;  // path of the scene manifest, relative to the recording (may be empty)
   nlohmann::json extra = nlohmann::json::object();  // anything else the writer added
 };
+
+// The record format the tracker settings name. InputError naming `file` for an unknown
+// device or encoding, or an output list the device cannot send.
+tracking::TrackerFormat tracker_format_of(const TrackerSettings& settings, const std::string& file);
 
 nlohmann::json session_to_json(const Session& session);
 // Throws InputError naming `file` and the key on missing or bad values.
