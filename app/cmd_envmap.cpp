@@ -68,16 +68,10 @@ SweepInput recording_sweep_input(const std::string& recording, const std::string
   }
   in.label_header = "index,time_ns";
 
-  std::vector<double> exposures{session.radiometry.exposure};
-  if (session.extra.contains("frame_exposures"))
-    exposures = session.extra["frame_exposures"].get<std::vector<double>>();
-  for (double e : exposures)
-    if (!(e > 0) || !std::isfinite(e))
-      throw InputError((dir / capture::kSessionFile).string() + ": exposures must be positive numbers");
-  const bool bracket = session.extra.value("exposure_bracket", false);
+  const std::size_t cycle = std::max<std::size_t>(1, session.frame_exposures.size());
   for (const auto& f : frames) {
-    in.exposures.push_back(exposures[std::size_t(f.index) % exposures.size()]);
-    if (bracket) in.groups.push_back(int(f.index / std::int64_t(exposures.size())));
+    in.exposures.push_back(session.frame_exposure(f.index));
+    if (session.exposure_bracket) in.groups.push_back(int(f.index / std::int64_t(cycle)));
   }
 
   calib::StitchSettings& st = in.stitch;
@@ -87,19 +81,15 @@ SweepInput recording_sweep_input(const std::string& recording, const std::string
   st.vignetting_a = session.radiometry.vignetting_a;
   st.vignetting_b = session.radiometry.vignetting_b;
   st.capture_position = mean_position;
-  if (session.extra.contains("envmap")) {
-    const auto& e = session.extra["envmap"];
-    if (e.contains("capture_position")) {
-      const auto p = e["capture_position"].get<std::vector<double>>();
-      if (p.size() == 3) st.capture_position = {p[0], p[1], p[2]};
-    }
-    st.azimuth_offset_deg = e.value("azimuth_offset_deg", 0.0);
+  if (session.envmap) {
+    if (session.envmap->capture_position) st.capture_position = *session.envmap->capture_position;
+    st.azimuth_offset_deg = session.envmap->azimuth_offset_deg;
     // The map a synthetic sweep was made from: the output is compared with it.
-    const std::string source_map = e.value("source_map", std::string());
+    const std::string& source_map = session.envmap->source_map;
     if (std::error_code ec; !source_map.empty() && std::filesystem::exists(source_map, ec))
       in.default_reference = source_map;
   }
-  if (session.extra.contains("synth")) in.tracker_noise_deg = session.extra["synth"].value("tracker_noise_deg", 0.75);
+  if (session.synth) in.tracker_noise_deg = session.synth->tracker_noise_deg;
 
   if (!reader.truth().empty())
     for (const auto& f : frames) {

@@ -98,7 +98,7 @@ void run(const IrradianceOptions& o) {
   std::string method = o.method;
   if (!o.scene.empty()) {
     scene = std::make_unique<Scene>(load_scene(o.scene));
-    if (method.empty()) method = scene_lighting_method(*scene);
+    if (method.empty()) method = scene->lighting.method;
   }
   if (method.empty()) method = "volume";
   std::vector<glm::dvec3> e;
@@ -123,7 +123,7 @@ void run(const IrradianceOptions& o) {
       distant.distant_map = true;
     }
     const Scene& s = scene ? *scene : distant;
-    const VolumeSettings settings = scene_volume_settings(s, method);
+    const VolumeSettings settings = scene_volume_settings(s.lighting, method);
     const auto radiance = scene_radiance(s, settings.radiance);
     bool loaded = false;
     IrradianceVolume volume =

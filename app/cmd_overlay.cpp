@@ -67,7 +67,7 @@ void register_overlay(CLI::App& app) {
     ReplayOverlay overlay(o->recording, o->scene, o->poses == "truth" ? PoseSource::Truth : PoseSource::Tracker,
                           o->window, undistortion, o->adapt_lighting);
     const auto& camera = overlay.compositor().output_camera();
-    const double fps = overlay.replay().reader().session().value("video", nlohmann::json::object()).value("fps", 30.0);
+    const double fps = overlay.replay().reader().video().fps;
     std::optional<VideoOutput> video;
     std::optional<FramesOutput> frames;
     if (!o->out.empty()) video.emplace(o->out, fps, cv::Size(camera.width, camera.height));

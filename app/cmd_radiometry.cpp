@@ -2,7 +2,6 @@
 // from a bracket of exposures and from flat-field images, optionally written into a
 // recording's session.json so that later overlays use it.
 #include <spdlog/spdlog.h>
-#include <fstream>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
@@ -10,7 +9,6 @@
 
 #include "commands.h"
 #include "lumar/base/error.h"
-#include "lumar/base/output_file.h"
 #include "lumar/calib/camera_file.h"
 #include "lumar/calib/camera_response.h"
 #include "lumar/calib/image_file.h"
@@ -26,23 +24,6 @@ cv::Mat read_image8(const std::string& path) {
   cv::Mat image = cv::imread(path, cv::IMREAD_COLOR);
   if (image.empty()) throw InputError(path + ": cannot decode this image; give a PNG or JPEG file");
   return image;
-}
-
-// Replaces the "radiometry" keys of DIR/session.json, atomically, and checks that the
-// result still reads as a session.
-void update_session_radiometry(const std::filesystem::path& recording, const nlohmann::json& changes) {
-  const auto file = recording / "session.json";
-  std::ifstream in(file);
-  if (!in) throw InputError(file.string() + ": cannot read it; --session wants a recording folder");
-  nlohmann::json j;
-  try {
-    j = nlohmann::json::parse(in);
-  } catch (const nlohmann::json::exception& e) {
-    throw InputError(file.string() + ": not valid JSON (" + e.what() + ")");
-  }
-  for (const auto& [key, value] : changes.items()) j["radiometry"][key] = value;
-  capture::session_from_json(j, file.string());  // throws InputError if the result is invalid
-  write_file_atomically(file, j.dump(2) + "\n");
 }
 
 struct ResponseOptions {
@@ -65,7 +46,8 @@ void run_response(const ResponseOptions& o) {
     calib::write_image_atomically(o.hdr, hdr);
   }
   if (!o.session.empty())
-    update_session_radiometry(o.session, {{"response", std::filesystem::absolute(o.out).string()}});
+    capture::update_session_file(
+        o.session, [&](capture::Session& s) { s.radiometry.response = std::filesystem::absolute(o.out).string(); });
 
   // Linear exposure at a few codes, per channel (BGR), normalised so 128 -> 1.
   nlohmann::json summary = {{"out", o.out}, {"images", o.images.size()}};
@@ -104,7 +86,11 @@ void run_vignetting(const VignettingOptions& o) {
   }
   sum /= double(o.images.size());
   const calib::VignettingFit fit = calib::estimate_vignetting(sum, camera.cx, camera.cy);
-  if (!o.session.empty()) update_session_radiometry(o.session, {{"vignetting", {fit.a, fit.b}}});
+  if (!o.session.empty())
+    capture::update_session_file(o.session, [&](capture::Session& s) {
+      s.radiometry.vignetting_a = fit.a;
+      s.radiometry.vignetting_b = fit.b;
+    });
   if (o.json) {
     const nlohmann::json j = {{"a", fit.a},
                               {"b", fit.b},

@@ -90,12 +90,8 @@ nlohmann::json rig_calibration_json(const RigCalibrationResult& r) {
 }
 
 void save_rig_to_session(const std::filesystem::path& dir, const RigCalibrationResult& result) {
-  const capture::RecordingReader reader(dir);
-  const std::filesystem::path file = dir / capture::kSessionFile;
-  capture::Session session = capture::session_from_json(reader.session(), file.string());
-  session.rig = result.rig;
-  session.extra["rig_calibration"] = rig_calibration_json(result);
-  write_file_atomically(file, capture::session_to_json(session).dump(2) + "\n");
+  capture::update_session_file(dir, [&](capture::Session& session) { session.rig = result.rig; },
+                               {{"rig_calibration", rig_calibration_json(result)}});
 }
 
 }  // namespace lumar::calib

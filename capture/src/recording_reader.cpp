@@ -50,6 +50,7 @@ RecordingReader::RecordingReader(const fs::path& dir) : dir_(dir) {
     throw InputError(session_file.string() + ": missing; " + dir.string() +
                      " is not a Lumar recording (or its writer died before starting)");
   const std::string text = csv::read_file(session_file);
+  nlohmann::json session_;
   try {
     session_ = nlohmann::json::parse(text);
   } catch (const nlohmann::json::parse_error& e) {
@@ -68,6 +69,11 @@ RecordingReader::RecordingReader(const fs::path& dir) : dir_(dir) {
                      (version == session_.end() ? "(none)" : version->dump()) + "; this Lumar reads version " +
                      std::to_string(kRecordingVersion));
   video_ = video_from_session(session_, session_file);
+  const auto complete = session_.find("complete");
+  complete_ = complete != session_.end() && complete->is_boolean() && complete->get<bool>();
+  // The session's own keys are parsed when asked for (session()): a recording made by
+  // a program that wrote other keys can still be read frame by frame.
+  session_json_ = std::move(session_);
 
   // The writer appends whole closed segments in order; anything else is damage.
   csv::for_each_row(dir / kFramesFile, kFramesHeader, 4, [&](const csv::Row& row) {
@@ -83,10 +89,7 @@ RecordingReader::RecordingReader(const fs::path& dir) : dir_(dir) {
   });
 }
 
-bool RecordingReader::complete() const {
-  const auto it = session_.find("complete");
-  return it != session_.end() && it->is_boolean() && it->get<bool>();
-}
+Session RecordingReader::session() const { return session_from_json(session_json_, (dir_ / kSessionFile).string()); }
 
 fs::path RecordingReader::segment_file(int segment) const { return segment_path(dir_, video_.codec, segment); }
 

@@ -5,8 +5,7 @@
 
 namespace lumar::capture {
 
-RecordingReplay::RecordingReplay(const std::filesystem::path& dir)
-    : reader_(dir), session_(session_from_json(reader_.session(), (dir / kSessionFile).string())) {
+RecordingReplay::RecordingReplay(const std::filesystem::path& dir) : reader_(dir), session_(reader_.session()) {
   const TrackerSettings& t = session_.tracker;
   const auto decoded = tracking::decode_tracker_stream(reader_.tracker_chunks(&stats_.torn_bytes),
                                                        tracker_format_of(t, (dir / kSessionFile).string()), t.baud,

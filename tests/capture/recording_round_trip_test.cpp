@@ -48,7 +48,7 @@ TEST_P(RecordingRoundTrip, ReadsBackWhatWasWritten) {
   }
 
   const RecordingReader reader(dir);
-  const nlohmann::json& s = reader.session();
+  const nlohmann::json s = test::session_file(dir);
   EXPECT_EQ(s["format"], "lumar-recording");
   EXPECT_EQ(s["version"], 1);
   EXPECT_EQ(s["complete"], true);
@@ -140,7 +140,7 @@ TEST(RecordingWriter, EmptyRecordingHasNoFramesAndNoTruthFile) {
   RecordingWriter(dir, nullptr, settings).close();
   const RecordingReader reader(dir);
   EXPECT_TRUE(reader.complete());
-  EXPECT_EQ(reader.session()["frames"], 0);
+  EXPECT_EQ(test::session_file(dir)["frames"], 0);
   EXPECT_TRUE(reader.frames().empty());
   EXPECT_TRUE(reader.tracker_chunks().empty());
   EXPECT_TRUE(reader.poses().empty());
@@ -213,7 +213,7 @@ TEST(RecordingWriter, MjpegQualityReachesTheEncoder) {
     writer.close();
     bytes[k] = fs::file_size(dir / "video" / "segment-000000.avi");
     const RecordingReader reader(dir);
-    EXPECT_EQ(reader.session()["video"]["quality"], qualities[k]);
+    EXPECT_EQ(test::session_file(dir)["video"]["quality"], qualities[k]);
     auto source = reader.open_frames();
     Frame frame;
     for (int i = 0; source->read(frame); ++i)

@@ -5,6 +5,8 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
 #include <opencv2/imgproc.hpp>
 #include <random>
 #include <string>
@@ -24,6 +26,12 @@ struct RemoveOnSuccess {
     if (!testing::Test::HasFailure()) std::filesystem::remove_all(dir, ec);
   }
 };
+
+// DIR/session.json as the writer left it, every key (the reader parses only the session's own).
+inline nlohmann::json session_file(const std::filesystem::path& dir) {
+  std::ifstream in(dir / "session.json");
+  return nlohmann::json::parse(in);
+}
 
 // A gradient, a block whose colour changes a lot from one index to the next, and
 // the index written large, so a frame decoded out of order cannot pass for another.

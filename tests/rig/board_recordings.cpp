@@ -8,8 +8,8 @@
 #include <functional>
 #include <map>
 #include <memory>
-#include <nlohmann/json.hpp>
 
+#include "lumar/capture/session.h"
 #include "test_paths.h"
 
 namespace lumar::test {
@@ -43,14 +43,12 @@ std::filesystem::path board_recording(const std::string& extra_args) {
 }
 
 tracking::Rig board_recording_truth(const std::filesystem::path& recording) {
-  std::ifstream in(recording / "session.json");
-  const auto j = nlohmann::json::parse(in);
-  const auto& t = j.at("synth_board").at("truth");
-  tracking::Rig rig;
-  rig.T_sensor_camera = tracking::pose_from_json(t.at("T_sensor_camera"), "truth");
-  rig.T_world_transmitter = tracking::pose_from_json(t.at("T_world_transmitter"), "truth");
-  rig.latency = t.at("latency_ns").get<Nanos>();
-  return rig;
+  const auto session = capture::load_session_file(recording / "session.json");
+  if (!session.synth_board) {
+    ADD_FAILURE() << recording << ": no synth_board truth";
+    return {};
+  }
+  return session.synth_board->truth;
 }
 
 const calib::RigRecording& loaded_board_recording(const std::string& extra_args) {

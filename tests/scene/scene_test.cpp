@@ -66,7 +66,7 @@ class SceneManifest : public ::testing::Test {
                "pose": {"translation": [0.5, 0.25, -0.75], "rotation_axis": [0, 2, 0], "rotation_deg": 30,
                         "scale": 0.001, "model_origin": [60, -60, -634]}},
               {"name": "plain", "mesh": "figurine.ply"}],
-  "lighting": {"method": "sh9", "samples": 64}
+  "lighting": {"method": "sh9", "irradiance": {"spacing": 0.25, "rays_per_probe": 256, "refine": false}}
 })";
 
   std::filesystem::path dir_;
@@ -82,8 +82,12 @@ TEST_F(SceneManifest, ValidManifestParses) {
   EXPECT_FALSE(scene.distant_map);
   EXPECT_EQ(scene.movement_min, glm::dvec3(-1, 0, -1));
   EXPECT_EQ(scene.movement_max, glm::dvec3(1, 1, 1));
-  EXPECT_EQ(scene.lighting.at("method"), "sh9");
-  EXPECT_EQ(scene.lighting.at("samples"), 64);
+  EXPECT_EQ(scene.lighting.method, "sh9");
+  EXPECT_EQ(scene.lighting.spacing, 0.25);
+  EXPECT_EQ(scene.lighting.rays_per_probe, 256);
+  EXPECT_EQ(scene.lighting.refine, false);
+  EXPECT_FALSE(scene.lighting.visibility.has_value());  // not given: the method's default
+  EXPECT_FALSE(scene.lighting.max_lights.has_value());
   ASSERT_EQ(scene.objects.size(), 2u);
 
   const SceneObject& fig = scene.objects[0];
@@ -114,7 +118,8 @@ TEST_F(SceneManifest, DistantMapNeedsNoRoomAndDefaultsApply) {
   EXPECT_DOUBLE_EQ(scene.azimuth_offset_deg, 0.0);
   EXPECT_EQ(scene.capture_position, glm::dvec3(0.0));
   EXPECT_TRUE(scene.objects.empty());
-  EXPECT_TRUE(scene.lighting.is_object() && scene.lighting.empty());
+  EXPECT_EQ(scene.lighting.method, "volume");
+  EXPECT_FALSE(scene.lighting.spacing.has_value());
 }
 
 TEST_F(SceneManifest, MalformedJsonGivesThePosition) {
@@ -164,7 +169,17 @@ TEST_F(SceneManifest, OtherStructuralErrors) {
                "missing");
   expect_error(write_changed("\"capture_position\": [0, 1.2, 0], ", ""), "environment_map.capture_position");
   expect_error(write_changed(R"("name": "plain")", R"("name": "figurine")"), "objects[1].name", "figurine");
-  expect_error(write_changed(R"("lighting": {"method": "sh9", "samples": 64})", R"("lighting": 3)"), "lighting");
+  const std::string lighting =
+      R"("lighting": {"method": "sh9", "irradiance": {"spacing": 0.25, "rays_per_probe": 256, "refine": false}})";
+  expect_error(write_changed(lighting, R"("lighting": 3)"), "lighting");
+  // The lighting settings are typed like the rest: unknown keys, methods and bad values are named.
+  expect_error(write_changed(lighting, R"("lighting": {"method": "sh9", "samples": 64})"), "lighting.samples",
+               "unknown key");
+  expect_error(write_changed(lighting, R"("lighting": {"method": "phong"})"), "lighting.method", "phong");
+  expect_error(write_changed(lighting, R"("lighting": {"irradiance": {"spacing": 0}})"), "lighting.irradiance.spacing");
+  expect_error(write_changed(lighting, R"("lighting": {"irradiance": {"rays_per_probe": 100.5}})"),
+               "lighting.irradiance.rays_per_probe", "whole");
+  expect_error(write_changed(lighting, R"("lighting": {"irradiance": {"refine": 1}})"), "lighting.irradiance.refine");
   expect_error(write("[1, 2, 3]"), "top level");
 }
 

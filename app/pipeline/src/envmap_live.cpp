@@ -102,19 +102,14 @@ void run_live_envmap(const LiveEnvmapOptions& o) {
                       : calib::load_camera_response(dir / session.radiometry.response);
     st.vignetting_a = session.radiometry.vignetting_a;
     st.vignetting_b = session.radiometry.vignetting_b;
-    exposures = {session.radiometry.exposure};
-    if (session.extra.contains("frame_exposures"))
-      exposures = session.extra["frame_exposures"].get<std::vector<double>>();
-    for (double e : exposures)
-      if (!(e > 0) || !std::isfinite(e)) throw InputError(o.in.source + ": session exposures must be positive numbers");
-    if (session.extra.contains("envmap"))
-      st.azimuth_offset_deg = session.extra["envmap"].value("azimuth_offset_deg", 0.0);
+    exposures =
+        session.frame_exposures.empty() ? std::vector<double>{session.radiometry.exposure} : session.frame_exposures;
     for (const auto& f : replay->reader().frames()) recorded_time[f.index] = f.time;
-    bracket = session.extra.value("exposure_bracket", false);
-    if (session.extra.contains("synth"))
-      kept.tracker_noise_deg = session.extra["synth"].value("tracker_noise_deg", 0.75);
-    if (session.extra.contains("envmap")) {
-      const std::string source_map = session.extra["envmap"].value("source_map", std::string());
+    bracket = session.exposure_bracket;
+    if (session.synth) kept.tracker_noise_deg = session.synth->tracker_noise_deg;
+    if (session.envmap) {
+      st.azimuth_offset_deg = session.envmap->azimuth_offset_deg;
+      const std::string& source_map = session.envmap->source_map;
       if (std::error_code ec; reference.empty() && !source_map.empty() && std::filesystem::exists(source_map, ec))
         reference = source_map;
     }

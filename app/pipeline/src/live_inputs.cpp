@@ -1,7 +1,6 @@
 #include "lumar/pipeline/live_inputs.h"
 
 #include <filesystem>
-#include <fstream>
 
 #include "lumar/base/error.h"
 #include "lumar/calib/camera_file.h"
@@ -89,15 +88,7 @@ tracking::Rig live_rig(const std::string& session_json, double latency_ms) {
   tracking::Rig rig;
   rig.latency = seconds_to_nanos(latency_ms * 1e-3);
   if (session_json.empty()) return rig;
-  std::ifstream in(session_json);
-  if (!in) throw InputError(session_json + ": cannot read the rig's session.json");
-  nlohmann::json j;
-  try {
-    j = nlohmann::json::parse(in);
-  } catch (const std::exception& e) {
-    throw InputError(session_json + ": malformed JSON (" + e.what() + ")");
-  }
-  return capture::session_from_json(j, session_json).rig;
+  return capture::load_session_file(session_json).rig;
 }
 
 nlohmann::json live_session(const LiveInputOptions& o, const CameraIntrinsics& camera,
@@ -115,12 +106,10 @@ nlohmann::json live_session(const LiveInputOptions& o, const CameraIntrinsics& c
     s.tracker.rate_hz = f.device == tracking::Device::Fastrak ? 120.0 : 60.0;
     s.tracker.station = driver->settings().stations.front();
   }
+  s.source = "lumar record";
+  s.capture = capture::CaptureInfo{o.source, o.tracker.empty() ? "none" : o.tracker, !o.camera_file.empty()};
   nlohmann::json j = capture::session_to_json(s);
-  j["source"] = "lumar record";
-  j["capture"] = {{"source", o.source},
-                  {"tracker", o.tracker.empty() ? "none" : o.tracker},
-                  {"camera_calibrated", !o.camera_file.empty()}};
-  if (!driver) j.erase("tracker");
+  if (!driver) j.erase("tracker");  // no tracker settings: the recording has no tracker stream
   return j;
 }
 

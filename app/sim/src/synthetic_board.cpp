@@ -176,20 +176,19 @@ void synthesize_board_recording(const BoardSynthSettings& s) {
   capture::Session session;
   session.camera = s.camera;
   session.rig.latency = seconds_to_nanos(s.assumed_latency_ms * 1e-3);
-  session.extra["source"] = "lumar synth --board";
-  session.extra["synth_board"] = {{"board", std::to_string(s.board.width) + "x" + std::to_string(s.board.height)},
-                                  {"square", s.square},
-                                  {"seconds", s.seconds},
-                                  {"fps", s.fps},
-                                  {"tracker_noise_deg", s.tracker_noise_deg},
-                                  {"position_noise_m", s.position_noise_m},
-                                  {"image_noise", s.image_noise},
-                                  {"seed", s.seed},
-                                  {"truth",
-                                   {{"T_world_transmitter", tracking::pose_to_json(truth.T_world_transmitter)},
-                                    {"T_sensor_camera", tracking::pose_to_json(truth.T_sensor_camera)},
-                                    {"T_world_board", tracking::pose_to_json(T_world_board)},
-                                    {"latency_ns", truth.latency}}}};
+  session.source = "lumar synth --board";
+  capture::BoardSynthInfo info;
+  info.board = std::to_string(s.board.width) + "x" + std::to_string(s.board.height);
+  info.square = s.square;
+  info.seconds = s.seconds;
+  info.fps = s.fps;
+  info.tracker_noise_deg = s.tracker_noise_deg;
+  info.position_noise_m = s.position_noise_m;
+  info.image_noise = s.image_noise;
+  info.seed = s.seed;
+  info.truth = truth;
+  info.T_world_board = T_world_board;
+  session.synth_board = info;
 
   // Half a second of tracker on either side of the video, so that a wrong assumed
   // latency still leaves tracker poses around every frame.

@@ -171,15 +171,17 @@ void synthesize_recording(const SynthSettings& s) {
   session.rig.latency = seconds_to_nanos(s.latency_ms * 1e-3);
   session.scene =
       std::filesystem::relative(std::filesystem::absolute(s.scene), std::filesystem::absolute(s.out)).string();
-  session.extra["source"] = "lumar synth";
-  session.extra["synth"] = {{"frames", s.frames},
-                            {"fps", s.fps},
-                            {"tracker_noise_deg", s.tracker_noise_deg},
-                            {"position_noise_m", s.position_noise_m},
-                            {"read_noise", s.read_noise},
-                            {"shot_noise_gain", s.shot_noise_gain},
-                            {"arc_deg", s.arc_deg},
-                            {"seed", s.seed}};
+  session.source = "lumar synth";
+  capture::SynthInfo synth;
+  synth.frames = s.frames;
+  synth.fps = s.fps;
+  synth.tracker_noise_deg = s.tracker_noise_deg;
+  synth.position_noise_m = s.position_noise_m;
+  synth.read_noise = s.read_noise;
+  synth.shot_noise_gain = s.shot_noise_gain;
+  synth.arc_deg = s.arc_deg;
+  synth.seed = s.seed;
+  session.synth = synth;
 
   const glm::dvec3 target = scene_target(scene);
   const Nanos start = seconds_to_nanos(0.1);  // tracker runs before the first frame

@@ -107,23 +107,23 @@ void synthesize_sweep(const SynthSettings& s, const SweepSynthSettings& sw) {
   session.radiometry.exposure = base;
   session.radiometry.vignetting_a = s.vignetting_a;
   session.radiometry.vignetting_b = s.vignetting_b;
-  session.extra["source"] = "lumar synth --sweep";
-  session.extra["frame_exposures"] = exposures;
+  session.source = "lumar synth --sweep";
+  session.frame_exposures = exposures;
   // Frames k = m n .. m n + n - 1 were taken standing still (one rotation).
-  session.extra["exposure_bracket"] = timing.bracket;
-  session.extra["envmap"] = {
-      {"capture_position", {sw.capture_position.x, sw.capture_position.y, sw.capture_position.z}},
-      {"azimuth_offset_deg", map.azimuth_offset_deg},
-      {"source_map", std::filesystem::absolute(sw.envmap).string()}};
-  session.extra["synth"] = {{"frames", s.frames},
-                            {"fps", s.fps},
-                            {"exposure_mode", sw.exposure_mode},
-                            {"exposure_stops", sw.exposure_stops},
-                            {"tracker_noise_deg", s.tracker_noise_deg},
-                            {"position_noise_m", s.position_noise_m},
-                            {"read_noise", s.read_noise},
-                            {"shot_noise_gain", s.shot_noise_gain},
-                            {"seed", s.seed}};
+  session.exposure_bracket = timing.bracket;
+  session.envmap =
+      capture::SweepInfo{sw.capture_position, map.azimuth_offset_deg, std::filesystem::absolute(sw.envmap).string()};
+  capture::SynthInfo synth;
+  synth.frames = s.frames;
+  synth.fps = s.fps;
+  synth.exposure_mode = sw.exposure_mode;
+  synth.exposure_stops = sw.exposure_stops;
+  synth.tracker_noise_deg = s.tracker_noise_deg;
+  synth.position_noise_m = s.position_noise_m;
+  synth.read_noise = s.read_noise;
+  synth.shot_noise_gain = s.shot_noise_gain;
+  synth.seed = s.seed;
+  session.synth = synth;
 
   const auto tracker = simulate_session_tracker(
       session, session.rig.latency, s.tracker_noise_deg, s.position_noise_m, s.seed,

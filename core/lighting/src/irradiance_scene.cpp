@@ -5,48 +5,14 @@
 
 namespace lumar {
 
-std::string scene_lighting_method(const Scene& scene) {
-  const auto it = scene.lighting.find("method");
-  if (it == scene.lighting.end()) return "volume";
-  if (!it->is_string())
-    throw InputError(scene.manifest.string() + ": lighting.method: expected a string such as \"volume\"");
-  return it->get<std::string>();
-}
-
-VolumeSettings scene_volume_settings(const Scene& scene, const std::string& method) {
-  VolumeSettings s = volume_settings_for(method == "sh9-object" ? "sh9" : method);
-  const auto it = scene.lighting.find("irradiance");
-  if (it == scene.lighting.end()) return s;
-  const std::string where = scene.manifest.string() + ": lighting.irradiance";
-  if (!it->is_object()) throw InputError(where + ": expected an object");
-  for (const auto& [key, value] : it->items()) {
-    const auto number = [&](double lo, double hi) {
-      if (!value.is_number() || value.get<double>() < lo || value.get<double>() > hi)
-        throw InputError(where + "." + key + ": expected a number in [" + std::to_string(lo) + ", " +
-                         std::to_string(hi) + "]");
-      return value.get<double>();
-    };
-    const auto boolean = [&] {
-      if (!value.is_boolean()) throw InputError(where + "." + key + ": expected true or false");
-      return value.get<bool>();
-    };
-    if (key == "spacing")
-      s.spacing = number(0.02, 100.0);
-    else if (key == "rays_per_probe")
-      s.rays_per_probe = int(number(16, 65536));
-    else if (key == "octahedral_resolution")
-      s.octahedral_resolution = int(number(2, 64));
-    else if (key == "max_lights")
-      s.radiance.max_lights = int(number(0, 32));
-    else if (key == "refine")
-      s.refine = boolean();
-    else if (key == "visibility")
-      s.visibility = boolean();
-    else
-      throw InputError(where + "." + key +
-                       ": unknown key; use spacing, rays_per_probe, octahedral_resolution, "
-                       "max_lights, refine or visibility");
-  }
+VolumeSettings scene_volume_settings(const LightingSettings& lighting, const std::string& method) {
+  VolumeSettings s = volume_settings_for(method);
+  if (lighting.spacing) s.spacing = *lighting.spacing;
+  if (lighting.rays_per_probe) s.rays_per_probe = *lighting.rays_per_probe;
+  if (lighting.octahedral_resolution) s.octahedral_resolution = *lighting.octahedral_resolution;
+  if (lighting.max_lights) s.radiance.max_lights = *lighting.max_lights;
+  if (lighting.refine) s.refine = *lighting.refine;
+  if (lighting.visibility) s.visibility = *lighting.visibility;
   return s;
 }
 

@@ -28,8 +28,8 @@ Compositor::Compositor(const Scene& scene, const CameraIntrinsics& output_camera
     renderer_->set_room(room);
   }
   // Spatially varying light: the irradiance volume over the movement box (cached on disk).
-  if (const std::string method = scene_lighting_method(scene); method != "sh9") {
-    const VolumeSettings settings = scene_volume_settings(scene, method);
+  if (const std::string& method = scene.lighting.method; method != "sh9") {
+    const VolumeSettings settings = scene_volume_settings(scene.lighting, method);
     const bool distant = scene.distant_map || room.triangle_count() == 0;
     const auto radiance = distant ? std::make_unique<RoomRadiance>(map, settings.radiance)
                                   : std::make_unique<RoomRadiance>(map, room, settings.radiance);

@@ -1,9 +1,11 @@
 #include "lumar/scene/scene.h"
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <glm/gtc/matrix_transform.hpp>
 #include <initializer_list>
+#include <nlohmann/json.hpp>
 #include <set>
 #include <sstream>
 
@@ -104,6 +106,12 @@ class ManifestReader {
   std::filesystem::path folder_;
 };
 
+std::string fmt_number(double v) {
+  std::ostringstream s;
+  s << v;
+  return s.str();
+}
+
 json parse_manifest(const std::filesystem::path& manifest) {
   const std::string name = manifest.string();
   if (!std::filesystem::is_regular_file(manifest))
@@ -176,6 +184,43 @@ std::vector<SceneBox> read_boxes(const ManifestReader& r, const json& parent, co
     boxes.push_back(b);
   }
   return boxes;
+}
+
+LightingSettings read_lighting(const ManifestReader& r, const json& doc) {
+  LightingSettings out;
+  if (!doc.contains("lighting")) return out;
+  const json& v = r.object(doc, "", "lighting");
+  r.only_keys(v, "lighting", {"method", "irradiance"});
+  if (v.contains("method")) {
+    out.method = r.string(v, "lighting", "method");
+    if (std::find(kLightingMethods.begin(), kLightingMethods.end(), out.method) == kLightingMethods.end()) {
+      std::string list;
+      for (const char* m : kLightingMethods) list += std::string(list.empty() ? "" : ", ") + m;
+      r.fail("lighting.method", "unknown method \"" + out.method + "\" (expected one of: " + list + ")");
+    }
+  }
+  if (!v.contains("irradiance")) return out;
+  const json& q = r.object(v, "lighting", "irradiance");
+  const std::string k = "lighting.irradiance";
+  r.only_keys(q, k, {"spacing", "rays_per_probe", "octahedral_resolution", "max_lights", "refine", "visibility"});
+  const auto in_range = [&](const char* name, double lo, double hi) -> std::optional<double> {
+    if (!q.contains(name)) return std::nullopt;
+    const double d = r.number(q.at(name), k + "." + name);
+    if (d < lo || d > hi) r.fail(k + "." + name, "expected a number from " + fmt_number(lo) + " to " + fmt_number(hi));
+    return d;
+  };
+  const auto integer = [&](const char* name, int lo, int hi) -> std::optional<int> {
+    const auto d = in_range(name, lo, hi);
+    if (d && *d != std::floor(*d)) r.fail(k + "." + name, "expected a whole number");
+    return d ? std::optional<int>(int(*d)) : std::nullopt;
+  };
+  out.spacing = in_range("spacing", 0.02, 100.0);
+  out.rays_per_probe = integer("rays_per_probe", 16, 65536);
+  out.octahedral_resolution = integer("octahedral_resolution", 2, 64);
+  out.max_lights = integer("max_lights", 0, 32);
+  if (q.contains("refine")) out.refine = r.boolean_or(q, k, "refine", true);
+  if (q.contains("visibility")) out.visibility = r.boolean_or(q, k, "visibility", true);
+  return out;
 }
 
 ShadowRegions read_shadows(const ManifestReader& r, const json& doc) {
@@ -254,10 +299,7 @@ Scene load_scene(const std::filesystem::path& manifest) {
     }
   }
 
-  if (doc.contains("lighting")) {
-    if (!doc.at("lighting").is_object()) r.fail("lighting", "expected an object");
-    scene.lighting = doc.at("lighting");
-  }
+  scene.lighting = read_lighting(r, doc);
   scene.shadows = read_shadows(r, doc);
   return scene;
 }

@@ -9,6 +9,7 @@
 
 #include "lumar/capture/frame_source.h"
 #include "lumar/capture/recording_format.h"
+#include "lumar/capture/session.h"
 #include "lumar/tracking/byte_chunk.h"
 #include "lumar/tracking/pose_sample.h"
 
@@ -22,9 +23,11 @@ class RecordingReader {
   explicit RecordingReader(const std::filesystem::path& dir);
 
   const std::filesystem::path& directory() const { return dir_; }
-  const nlohmann::json& session() const { return session_; }
+  // The session (camera, radiometry, tracker, rig, ...): InputError naming session.json
+  // when it does not read as one.
+  Session session() const;
   const RecordingSettings& video() const { return video_; }  // from session.json "video"
-  bool complete() const;                                     // closed cleanly (false after a crash)
+  bool complete() const { return complete_; }                // closed cleanly (false after a crash)
   const std::vector<FrameEntry>& frames() const { return frames_; }
   std::filesystem::path segment_file(int segment) const;
 
@@ -36,7 +39,8 @@ class RecordingReader {
 
  private:
   std::filesystem::path dir_;
-  nlohmann::json session_;
+  nlohmann::json session_json_;  // parsed by session()
+  bool complete_ = false;
   RecordingSettings video_;
   std::vector<FrameEntry> frames_;
 };

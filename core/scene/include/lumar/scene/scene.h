@@ -2,9 +2,10 @@
 // The scene manifest (scene.json, format in docs/formats.md): the proxy room model,
 // the environment map, the box where virtual objects may move, the virtual objects
 // and the lighting settings. Relative paths are resolved against the manifest's folder.
+#include <array>
 #include <filesystem>
 #include <glm/glm.hpp>
-#include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -35,6 +36,19 @@ struct ShadowRegions {
   int receiver_vertices = 3200;     // about this many receiver vertices, spread uniformly
 };
 
+// The manifest's "lighting": how the virtual objects are shaded (docs/irradiance.md).
+struct LightingSettings {
+  std::string method = "volume";  // one of kLightingMethods
+  // "irradiance": the volume's quality knobs; those not given keep the method's defaults.
+  std::optional<double> spacing;
+  std::optional<int> rays_per_probe, octahedral_resolution, max_lights;
+  std::optional<bool> refine, visibility;
+};
+// volume: the irradiance volume (SH9 + an octahedral correction + exact dominant lights);
+// sh9: nine SH coefficients for the whole scene; octahedral, lights: the volume with one
+// representation; greger2004: the 2004 baseline.
+inline constexpr std::array<const char*, 5> kLightingMethods{"volume", "sh9", "octahedral", "lights", "greger2004"};
+
 struct Scene {
   std::filesystem::path manifest;
   std::filesystem::path room_mesh;
@@ -45,7 +59,7 @@ struct Scene {
   bool distant_map = false;  // map at infinity: no proxy needed for lighting
   glm::dvec3 movement_min{0.0}, movement_max{0.0};
   std::vector<SceneObject> objects;
-  nlohmann::json lighting = nlohmann::json::object();  // per-method settings, kept as given
+  LightingSettings lighting;
   ShadowRegions shadows;
 };
 
