@@ -94,47 +94,35 @@ void run(const IrradianceOptions& o) {
   if (o.scene.empty() == o.envmap.empty())
     throw InputError("lumar irradiance: give either --scene S or --envmap MAP.exr");
   const Query q = read_queries(o.query);
-  std::unique_ptr<Scene> scene;
-  std::string method = o.method;
+  // A scene, or a distant map alone: either way its files are decoded once, here.
+  Scene manifest;
   if (!o.scene.empty()) {
-    scene = std::make_unique<Scene>(load_scene(o.scene));
-    if (method.empty()) method = scene->lighting.method;
+    manifest = load_scene(o.scene);
+  } else {
+    manifest.manifest = o.envmap;
+    manifest.environment_map = o.envmap;
+    manifest.distant_map = true;
   }
-  if (method.empty()) method = "volume";
+  const LoadedScene scene = load_scene_files(manifest);
+  const std::string method = o.method.empty() ? manifest.lighting.method : o.method;
   std::vector<glm::dvec3> e;
   if (method == "reference") {
-    std::unique_ptr<RoomRadiance> radiance;
-    if (scene) {
-      radiance = scene_radiance(*scene, reference_radiance_settings());
-    } else {
-      e = texel_sum_irradiance(load_environment_map(o.envmap), q.normals);
-    }
-    if (radiance && radiance->distant())
+    const auto radiance = scene_radiance(scene, reference_radiance_settings());
+    if (radiance->distant()) {
       e = texel_sum_irradiance(radiance->working_map(), q.normals);
-    else if (radiance)
+    } else {
       e = reference_irradiance(*radiance, q.points, q.normals, o.strata);
-    if (radiance)
       spdlog::info("reference: {} rays, {} used the fallback", radiance->traced_rays(), radiance->fallback_rays());
-  } else {
-    Scene distant;
-    if (!scene) {
-      distant.manifest = o.envmap;
-      distant.environment_map = o.envmap;
-      distant.distant_map = true;
     }
-    const Scene& s = scene ? *scene : distant;
-    const VolumeSettings settings = scene_volume_settings(s.lighting, method);
-    const auto radiance = scene_radiance(s, settings.radiance);
+  } else {
     bool loaded = false;
-    IrradianceVolume volume =
-        o.no_cache ? IrradianceVolume::build(*radiance, s.movement_min, s.movement_max, settings)
-                   : cached_irradiance_volume(*radiance, s.movement_min, s.movement_max, settings, o.cache, &loaded);
+    const IrradianceVolume volume = scene_irradiance_volume(scene, method, !o.no_cache, o.cache, &loaded);
     const auto& st = volume.stats();
     spdlog::info(
         "irradiance volume ({}): {} {} probes ({} moved, {} disabled), {} cells ({} refined), {:.0f} ms, "
         "{} rays, {} fallback",
-        settings.describe(), loaded ? "loaded" : "built", st.probes, st.moved, st.disabled, st.cells, st.refined_cells,
-        st.build_ms, st.rays, st.fallback_rays);
+        volume.settings().describe(), loaded ? "loaded" : "built", st.probes, st.moved, st.disabled, st.cells,
+        st.refined_cells, st.build_ms, st.rays, st.fallback_rays);
     for (std::size_t i = 0; i < q.points.size(); ++i) e.push_back(volume.evaluate(q.points[i], q.normals[i]));
   }
   write_results(o.out, e);

@@ -10,7 +10,7 @@
 #include "lumar/base/error.h"
 #include "lumar/base/output_file.h"
 #include "lumar/lighting/shadows/shadow_methods.h"
-#include "lumar/scene/scene.h"
+#include "lumar/scene/loaded_scene.h"
 
 namespace lumar::app {
 
@@ -85,10 +85,10 @@ void register_shadows(CLI::App& app) {
       ->capture_default_str();
   add_action(cmd, [o] {
     const ShadowMethod method = parse_shadow_method(o->method);
-    const Scene scene = load_scene(o->scene);
+    LoadedScene scene = load_scene_files(std::filesystem::path(o->scene));
     std::vector<glm::vec3> positions, normals;
     read_query(o->query, positions, normals);
-    const ShadowScene shadows(scene);
+    const ShadowScene shadows(std::move(scene));
     const auto attenuation = shadow_attenuation(shadows, positions, normals, method);
     write_result(o->out, attenuation);
     spdlog::info("shadows ({}): {} points, {} occluder(s) -> {}", o->method, positions.size(), shadows.objects().size(),

@@ -56,10 +56,11 @@ double mean_error_percent(const std::vector<glm::dvec3>& a, const std::vector<gl
 
 int main() {
   const std::filesystem::path source(LUMAR_SOURCE_DIR);
-  const Scene scene = load_scene(source / "data/scenes/room/scene.json");
+  const LoadedScene loaded = load_scene_files(source / "data/scenes/room/scene.json");
+  const Scene& scene = loaded.manifest;
 
   // Room: reference points.
-  const auto reference_room = scene_radiance(scene, reference_radiance_settings());
+  const auto reference_room = scene_radiance(loaded, reference_radiance_settings());
   std::mt19937 rng(17);
   std::vector<glm::dvec3> points, normals = lumar::test::random_normals(60, 5);
   for (int i = 0; i < 60; ++i) {
@@ -88,7 +89,7 @@ int main() {
   room.note = memory.note = "60 points x random normals in the movement box; reference " +
                             std::to_string(int(reference_ms)) + " ms per point";
   for (const Config& c : configs()) {
-    const auto radiance = scene_radiance(scene, c.settings.radiance);
+    const auto radiance = scene_radiance(loaded, c.settings.radiance);
     const IrradianceVolume v = IrradianceVolume::build(*radiance, scene.movement_min, scene.movement_max, c.settings);
     std::vector<glm::dvec3> e;
     for (std::size_t i = 0; i < points.size(); ++i) e.push_back(v.evaluate(points[i], normals[i]));

@@ -21,7 +21,9 @@ struct Fixture {
 
   Fixture() {
     const auto maps = calib::make_undistortion_maps(replay.session().camera);
-    compositor = std::make_unique<Compositor>(load_scene(replay.scene_path()), maps.output, maps.map_x, maps.map_y);
+    compositor =
+        std::make_unique<Compositor>(std::make_shared<const LoadedScene>(load_scene_files(replay.scene_path())),
+                                     maps.output, maps.map_x, maps.map_y);
     frames = replay.open_frames();
   }
   // Next frame, starting over at the end.

@@ -41,7 +41,7 @@ Setup& setup() {
     Scene manifest = load_scene(std::filesystem::path(LUMAR_SOURCE_DIR) / "data/scenes/room/scene.json");
     manifest.shadows.receiver_vertices = 3400;
     out.base_pose = manifest.objects.at(0).T_world_model;
-    out.scene = std::make_unique<ShadowScene>(manifest);
+    out.scene = std::make_unique<ShadowScene>(load_scene_files(manifest));
     out.receivers = out.scene->receivers();
     return out;
   }();

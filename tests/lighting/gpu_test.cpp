@@ -123,7 +123,8 @@ TEST(IrradianceGpu, ShaderMatchesTheCpuEvaluationAtTheSameWorldPoints) {
 
 TEST(IrradianceGpu, CompositorShadingFollowsTheObjectThroughTheSampleRoom) {
   context();
-  const Scene scene = load_scene(source_dir() / "data/scenes/room/scene.json");
+  const auto scene =
+      std::make_shared<const LoadedScene>(load_scene_files(source_dir() / "data/scenes/room/scene.json"));
   const CameraIntrinsics cam = camera(120, 90, 110);
   Compositor compositor(scene, cam, cv::Mat(), cv::Mat());
   const IrradianceVolume* v = compositor.irradiance_volume();
@@ -135,7 +136,7 @@ TEST(IrradianceGpu, CompositorShadingFollowsTheObjectThroughTheSampleRoom) {
   const glm::vec3 albedo(0.6f);
   r.set_object_material(id, albedo, SH9{});
   // Hide the scene's own objects far away, so they do not cover the sphere.
-  for (std::size_t k = 0; k < scene.objects.size(); ++k)
+  for (std::size_t k = 0; k < scene->objects.size(); ++k)
     compositor.set_object_pose(k, glm::translate(glm::dmat4(1.0), glm::dvec3(100, 100, 100)));
   std::vector<Comparison> at;
   for (const glm::dvec3 centre : {glm::dvec3(-1.0, 0.2, 1.0), glm::dvec3(0.3, 0.9, -0.3)}) {

@@ -89,7 +89,7 @@ Errors compare(const std::vector<glm::vec3>& a, const std::vector<glm::vec3>& re
 
 // 1. The sample room's real map and proxy emitters: a ball on the floor under a hovering slab.
 TEST(ObjectShadows, MatchesReferenceInSampleRoom) {
-  const ShadowScene scene(load_scene(test::source_dir() / "data/scenes/room/scene.json"));
+  const ShadowScene scene(load_scene_files(test::source_dir() / "data/scenes/room/scene.json"));
   const Mesh ball = test::make_sphere(glm::vec3(0.0f), 0.12f, 32, 16);
   const Mesh slab = test::make_box({-0.2f, -0.02f, -0.2f}, {0.2f, 0.02f, 0.2f});
   const glm::dmat4 T_ball = translation(-0.4, 0.12, 0.4), T_slab = translation(-0.3, 0.45, 0.35);

@@ -5,13 +5,12 @@
 
 #include "lumar/lighting/shadows/shadow_lines.h"
 #include "lumar/lighting/shadows/shadow_methods.h"
+#include "lumar/scene/loaded_scene.h"
 #include "lumar/scene/mesh.h"
-#include "lumar/scene/scene.h"
 
 namespace lumar::test {
 
 struct SampleRoomLines {
-  Scene manifest;
   std::unique_ptr<ShadowScene> scene;
   Mesh receivers;
   ShadowLines lines;

@@ -57,14 +57,14 @@ TEST(ShadowAcceptance, FigurineAboveSampleFloor) {
   Scene s = load_scene(test::source_dir() / "data/scenes/room/scene.json");
   ASSERT_EQ(s.objects.size(), 1u);
   s.objects[0].T_world_model = glm::translate(glm::dmat4(1.0), glm::dvec3(0, 0.15, 0)) * s.objects[0].T_world_model;
-  const ShadowScene scene(s);
+  const ShadowScene scene(load_scene_files(s));
   check_against_reference(scene, floor_points_around(scene, 0.0f, 32), "figurine");
 }
 
 TEST(ShadowAcceptance, SphereAboveSampleFloor) {
   Scene s = load_scene(test::source_dir() / "data/scenes/room/scene.json");
   s.objects.clear();
-  ShadowScene base(s);
+  ShadowScene base(load_scene_files(s));
   std::vector<ShadowScene::Object> objects{{"sphere", test::make_sphere({0, 0, 0}, 0.2f, 48, 24),
                                             glm::translate(glm::dmat4(1.0), glm::dvec3(-0.3, 0.45, 0.4))}};
   EnvironmentMap map = base.map();

@@ -195,7 +195,7 @@ TEST(ShadowCulling, CandidatesContainEveryBlockedLine) {
   std::uniform_real_distribution<double> u(0, 1);
   std::size_t blocked = 0;
   for (int k = 0; k < 12; ++k) {
-    const Scene& s = room.manifest;
+    const Scene& s = room.scene->scene().manifest;
     const glm::dvec3 at(s.movement_min.x + u(rng) * (s.movement_max.x - s.movement_min.x), 0.1 + 0.4 * u(rng),
                         s.movement_min.z + u(rng) * (s.movement_max.z - s.movement_min.z));
     glm::dmat4 T = pose(6.3 * u(rng), at);

@@ -5,8 +5,8 @@
 #include <gtest/gtest.h>
 
 #include <fstream>
-#include <nlohmann/json.hpp>
 #include <glm/gtc/matrix_transform.hpp>
+#include <nlohmann/json.hpp>
 #include <numbers>
 #include <random>
 
@@ -157,7 +157,7 @@ TEST(ShadowOcclusion, CullingChangesNothingAndSkipsWhenStill) {
 
 TEST(ShadowReceivers, DefaultFloorUnderMovementBox) {
   Scene s = load_scene(test::source_dir() / "data/scenes/room/scene.json");
-  const ShadowScene scene(s);
+  const ShadowScene scene(load_scene_files(s));
   const Mesh rec = scene.receivers();
   EXPECT_NEAR(double(rec.positions.size()), 3200.0, 300.0);
   EXPECT_GT(rec.triangle_count(), 5000u);
@@ -193,7 +193,7 @@ TEST(ShadowManifest, ReadsRegionsAndKeepsOldManifestsValid) {
   ASSERT_EQ(s.shadows.emitters.size(), 1u);
   EXPECT_EQ(s.shadows.receiver_vertices, 500);
   // The table top receives: its vertices lie at the table's height.
-  const Mesh table = ShadowScene(s).receivers();
+  const Mesh table = ShadowScene(load_scene_files(s)).receivers();
   ASSERT_GT(table.positions.size(), 300u);
   for (const auto& p : table.positions) ASSERT_NEAR(p.y, 0.72f, 1e-4f);
   j["shadows"]["recievers"] = nlohmann::json::array();

@@ -75,13 +75,13 @@ cv::Mat room_video(Compositor& compositor, const CameraIntrinsics& camera, const
 struct SampleView {
   CameraIntrinsics camera;
   Pose pose;
-  Scene scene;
+  LoadedScene scene;
 };
 SampleView sample_view() {
   context();
   SampleView v;
   recording_view(15, v.camera, v.pose);
-  v.scene = load_scene(test::source_dir() / "data/scenes/room/scene.json");
+  v.scene = load_scene_files(test::source_dir() / "data/scenes/room/scene.json");
   return v;
 }
 
@@ -89,7 +89,7 @@ TEST(ShadowOverlay, VideoDarkensWhereTheLinesSayAndNowhereElse) {
   auto [camera, pose, scene] = sample_view();
   // Lift the figurine a little so that its shadow is a visible patch, not only contact.
   const glm::dmat4 T = glm::translate(glm::dmat4(1.0), glm::dvec3(0, 0.12, 0)) * scene.objects[0].T_world_model;
-  Compositor compositor(scene, camera, cv::Mat(), cv::Mat());
+  Compositor compositor(std::make_shared<const LoadedScene>(scene), camera, cv::Mat(), cv::Mat());
   compositor.set_object_pose(0, T);
   ASSERT_NE(compositor.shadows(), nullptr);
   const double exposure = 0.66;
@@ -164,11 +164,11 @@ TEST(ShadowOverlay, VideoDarkensWhereTheLinesSayAndNowhereElse) {
 // ratio (against the same frame with shadows off).
 TEST(ShadowOverlay, ObjectsShadowEachOther) {
   auto [camera, pose, scene] = sample_view();
-  SceneObject upper = scene.objects[0];
+  LoadedObject upper = scene.objects[0];
   upper.name = "upper";
   upper.T_world_model = glm::translate(glm::dmat4(1.0), glm::dvec3(0.12, 0.32, -0.1)) * upper.T_world_model;
   scene.objects.push_back(upper);
-  Compositor compositor(scene, camera, cv::Mat(), cv::Mat());
+  Compositor compositor(std::make_shared<const LoadedScene>(scene), camera, cv::Mat(), cv::Mat());
   ASSERT_NE(compositor.object_shadows(), nullptr);
   const double exposure = 0.66;
   const cv::Mat video = room_video(compositor, camera, pose, exposure);
@@ -184,7 +184,7 @@ TEST(ShadowOverlay, ObjectsShadowEachOther) {
 
   const ObjectShadows& shadows = *compositor.object_shadows();
   const std::vector<glm::vec3>& att = shadows.vertex_attenuation(0);
-  const Mesh lower = transformed(load_mesh(scene.objects[0].mesh), scene.objects[0].T_world_model);
+  const Mesh lower = transformed(scene.objects[0].model, scene.objects[0].T_world_model);
   // The attenuation the GPU should show where a pixel sees the point x of the lower
   // figurine: interpolated over the triangle around x (one of vertex i's triangles).
   std::vector<std::vector<std::uint32_t>> triangles_of(lower.positions.size());

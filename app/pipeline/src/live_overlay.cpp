@@ -11,13 +11,13 @@
 #include "lumar/pipeline/stop_signal.h"
 #include "lumar/render/compositor.h"
 #include "lumar/render/platform/context.h"
-#include "lumar/scene/scene.h"
+#include "lumar/scene/loaded_scene.h"
 
 namespace lumar::app {
 
 void run_live_overlay(const LiveOverlayOptions& o) {
   if (o.scene.empty()) throw InputError("overlay: the live path needs --scene");
-  const Scene scene = load_scene(o.scene);
+  const auto scene = std::make_shared<const LoadedScene>(load_scene_files(o.scene));
   const tracking::Rig rig = live_rig(o.rig.string(), o.in.latency_ms);
   LiveSource live = open_live_source(o.in);
   const cv::Size size = live.source->frame_size();

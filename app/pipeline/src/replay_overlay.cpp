@@ -38,7 +38,7 @@ ReplayOverlay::ReplayOverlay(const std::filesystem::path& recording, const std::
     : replay_(recording), pose_source_(poses) {
   const std::filesystem::path scene_path = scene_override.empty() ? replay_.scene_path() : scene_override;
   if (scene_path.empty()) throw InputError((recording / "session.json").string() + ": names no scene; pass --scene");
-  scene_ = load_scene(scene_path);
+  scene_ = std::make_shared<const LoadedScene>(load_scene_files(scene_path));
   if (poses == PoseSource::Truth && replay_.reader().truth().empty())
     throw InputError(recording.string() + ": has no ground truth (truth.csv); use the tracker's poses");
 

@@ -12,9 +12,7 @@
 #include "lumar/capture/session.h"
 #include "lumar/render/platform/context.h"
 #include "lumar/render/renderer.h"
-#include "lumar/scene/envmap.h"
-#include "lumar/scene/mesh.h"
-#include "lumar/scene/scene.h"
+#include "lumar/scene/loaded_scene.h"
 #include "lumar/sim/envmap_view.h"
 #include "lumar/tracking/simulated_tracker.h"
 #include "lumar/tracking/tracker_stream.h"
@@ -123,10 +121,10 @@ cv::Mat expose(const cv::Mat& radiance_bgr, const CameraIntrinsics& camera, cons
 
 // Where the camera looks: the foot of the first virtual object (the centre of its
 // world bounding box, at its lowest point), else the middle of the movement box.
-glm::dvec3 scene_target(const Scene& scene) {
-  if (scene.objects.empty()) return 0.5 * (scene.movement_min + scene.movement_max);
-  const SceneObject& object = scene.objects.front();
-  const auto [lo, hi] = transformed(load_mesh(object.mesh), object.T_world_model).bounds();
+glm::dvec3 scene_target(const LoadedScene& scene) {
+  if (scene.objects.empty()) return 0.5 * (scene.manifest.movement_min + scene.manifest.movement_max);
+  const LoadedObject& object = scene.objects.front();
+  const auto [lo, hi] = transformed(object.model, object.T_world_model).bounds();
   return {0.5 * (lo.x + hi.x), lo.y, 0.5 * (lo.z + hi.z)};
 }
 
@@ -149,18 +147,14 @@ void synthesize_recording(const SynthSettings& s) {
   if (s.fps <= 0) throw InputError("--fps: must be positive");
   if (std::filesystem::exists(s.out))
     throw InputError(s.out.string() + ": already exists; choose a new recording directory");
-  const Scene scene = load_scene(s.scene);
-  EnvironmentMap map = load_environment_map(scene.environment_map);
-  map.capture_position = scene.capture_position;
-  map.azimuth_offset_deg = scene.azimuth_offset_deg;
-  if (scene.room_mesh.empty()) throw InputError(s.scene.string() + ": synth needs a proxy room (room.mesh)");
-  const Mesh room = transformed(load_mesh(scene.room_mesh), glm::dmat4(glm::dmat3(scene.room_scale)));
+  const LoadedScene scene = load_scene_files(s.scene);
+  if (scene.room.triangle_count() == 0) throw InputError(s.scene.string() + ": synth needs a proxy room (room.mesh)");
 
   auto context = gl::create_headless_context();
   const CameraIntrinsics pinhole = covering_pinhole(s.camera, s.supersample);
   gl::Renderer renderer(pinhole);
-  renderer.set_room(room);
-  renderer.set_environment(map);
+  renderer.set_room(scene.room);
+  renderer.set_environment(scene.map);
 
   // The rig: transmitter on the table, +Z (Polhemus down) along world -Y; the sensor
   // clipped to the camera a few centimetres away, turned 90 degrees.

@@ -16,14 +16,19 @@ VolumeSettings scene_volume_settings(const LightingSettings& lighting, const std
   return s;
 }
 
-std::unique_ptr<RoomRadiance> scene_radiance(const Scene& scene, const RadianceSettings& settings) {
-  EnvironmentMap map = load_environment_map(scene.environment_map);
-  map.capture_position = scene.capture_position;
-  map.azimuth_offset_deg = scene.azimuth_offset_deg;
-  if (scene.distant_map || scene.room_mesh.empty()) return std::make_unique<RoomRadiance>(map, settings);
-  const double k = scene.room_scale;
-  return std::make_unique<RoomRadiance>(map, transformed(load_mesh(scene.room_mesh), glm::dmat4(glm::dmat3(k))),
-                                        settings);
+std::unique_ptr<RoomRadiance> scene_radiance(const LoadedScene& scene, const RadianceSettings& settings) {
+  if (scene.distant()) return std::make_unique<RoomRadiance>(scene.map, settings);
+  return std::make_unique<RoomRadiance>(scene.map, scene.room, settings);
+}
+
+IrradianceVolume scene_irradiance_volume(const LoadedScene& scene, const std::string& method, bool use_cache,
+                                         const std::filesystem::path& cache_dir, bool* loaded) {
+  const VolumeSettings settings = scene_volume_settings(scene.manifest.lighting, method);
+  const auto radiance = scene_radiance(scene, settings.radiance);
+  const Scene& m = scene.manifest;
+  if (loaded) *loaded = false;
+  if (!use_cache) return IrradianceVolume::build(*radiance, m.movement_min, m.movement_max, settings);
+  return cached_irradiance_volume(*radiance, m.movement_min, m.movement_max, settings, cache_dir, loaded);
 }
 
 }  // namespace lumar

@@ -7,60 +7,45 @@
 #include "lumar/lighting/shadows/object_shadows.h"
 #include "lumar/lighting/shadows/shadow_methods.h"
 #include "lumar/lighting/shadows/shadow_occlusion.h"
-#include "lumar/scene/envmap.h"
-#include "lumar/scene/mesh.h"
 
 namespace lumar {
 
-Compositor::Compositor(const Scene& scene, const CameraIntrinsics& output_camera, const cv::Mat& map_x,
-                       const cv::Mat& map_y)
-    : camera_(output_camera.without_distortion()) {
-  EnvironmentMap map = load_environment_map(scene.environment_map);
-  map.capture_position = scene.capture_position;
-  map.azimuth_offset_deg = scene.azimuth_offset_deg;
-  sh_ = project_radiance_sh9(map);
-
+Compositor::Compositor(std::shared_ptr<const LoadedScene> scene, const CameraIntrinsics& output_camera,
+                       const cv::Mat& map_x, const cv::Mat& map_y)
+    : camera_(output_camera.without_distortion()), scene_(std::move(scene)) {
+  const LoadedScene& s = *scene_;
+  sh_ = project_radiance_sh9(s.map);
   renderer_ = std::make_unique<gl::Renderer>(camera_);
-  Mesh room;
-  if (!scene.room_mesh.empty()) {
-    const double s = scene.room_scale;
-    room = transformed(load_mesh(scene.room_mesh), glm::dmat4(glm::dmat3(s)));
-    renderer_->set_room(room);
-  }
+  if (s.room.triangle_count() > 0) renderer_->set_room(s.room);
   // Spatially varying light: the irradiance volume over the movement box (cached on disk).
-  if (const std::string& method = scene.lighting.method; method != "sh9") {
-    const VolumeSettings settings = scene_volume_settings(scene.lighting, method);
-    const bool distant = scene.distant_map || room.triangle_count() == 0;
-    const auto radiance = distant ? std::make_unique<RoomRadiance>(map, settings.radiance)
-                                  : std::make_unique<RoomRadiance>(map, room, settings.radiance);
+  if (const std::string& method = s.manifest.lighting.method; method != "sh9") {
     bool loaded = false;
-    volume_ = std::make_shared<IrradianceVolume>(
-        cached_irradiance_volume(*radiance, scene.movement_min, scene.movement_max, settings, {}, &loaded));
+    volume_ = std::make_shared<IrradianceVolume>(scene_irradiance_volume(s, method, true, {}, &loaded));
     renderer_->set_irradiance_volume(volume_.get());
-    spdlog::debug("irradiance volume ({}): {} probes, {}", settings.describe(), volume_->stats().probes,
+    spdlog::debug("irradiance volume ({}): {} probes, {}", volume_->settings().describe(), volume_->stats().probes,
                   loaded ? "loaded from the cache" : "built");
   }
-  renderer_->set_environment(map);
+  renderer_->set_environment(s.map);
   if (!map_x.empty()) renderer_->set_undistortion_map(map_x, map_y);
 
-  for (const SceneObject& object : scene.objects) {
-    const Mesh mesh = load_mesh(object.mesh);
-    const int id = renderer_->add_object(mesh);
+  for (const LoadedObject& object : s.objects) {
+    const int id = renderer_->add_object(object.model);
     renderer_->set_object_pose(id, object.T_world_model);
     renderer_->set_object_material(id, object.albedo, sh_);
     // Every k-th vertex, so that checks see the whole object at a bounded cost.
+    const Mesh& mesh = object.model;
     const std::size_t step = std::max<std::size_t>(1, mesh.positions.size() / 200);
     for (std::size_t i = 0; i < mesh.positions.size(); i += step)
       object_points_.push_back(glm::dvec3(object.T_world_model * glm::dvec4(glm::dvec3(mesh.positions[i]), 1.0)));
     spdlog::debug("object '{}': {} triangles", object.name, mesh.triangle_count());
   }
-  build_shadows(scene);
+  build_shadows();
 }
 
 // Precomputes the shadow lines from the scene's receivers to its emitters (the objects
 // are the occluders), and with two objects or more their shadows on each other.
-void Compositor::build_shadows(const Scene& scene) {
-  const ShadowScene shadow_scene(scene);
+void Compositor::build_shadows() {
+  const ShadowScene shadow_scene(scene_);
   const auto& objects = shadow_scene.objects();
   const Mesh receivers = shadow_scene.receivers();
   const bool on_receivers = receivers.triangle_count() > 0 && !objects.empty();

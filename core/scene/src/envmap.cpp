@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "decode_counter.h"
 #include "lumar/base/color.h"
 #include "lumar/base/error.h"
 #include "lumar/base/latlong.h"
@@ -95,6 +96,7 @@ EnvironmentMap load_environment_map(const std::filesystem::path& path) {
     throw InputError(name + ": environment map pixel (" + std::to_string(pixel % w) + ", " + std::to_string(pixel / w) +
                      ") is not finite; repair the map");
   }
+  count_decode(path);
   return map;
 }
 

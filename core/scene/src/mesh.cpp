@@ -8,6 +8,7 @@
 #include <cmath>
 #include <limits>
 
+#include "decode_counter.h"
 #include "lumar/base/error.h"
 
 namespace lumar {
@@ -103,6 +104,7 @@ Mesh load_mesh(const std::filesystem::path& path) {
     for (std::uint32_t i : part_indices) mesh.indices.push_back(base + i);
   }
   if (mesh.indices.empty()) throw InputError(name + ": mesh holds no triangles; export the model with its faces");
+  count_decode(path);
   return mesh;
 }
 

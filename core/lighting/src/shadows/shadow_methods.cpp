@@ -132,46 +132,40 @@ ShadowMethod parse_shadow_method(const std::string& name) {
   throw InputError("--method: unknown method '" + name + "'; use lines, reference or sphere");
 }
 
-ShadowScene::ShadowScene(const Scene& scene) : regions_(scene.shadows) {
-  map_ = load_environment_map(scene.environment_map);
-  map_.capture_position = scene.capture_position;
-  map_.azimuth_offset_deg = scene.azimuth_offset_deg;
-  distant_ = scene.distant_map;
-  movement_min_ = scene.movement_min;
-  movement_max_ = scene.movement_max;
-  if (!scene.room_mesh.empty())
-    room_ = transformed(load_mesh(scene.room_mesh), glm::dmat4(glm::dmat3(scene.room_scale)));
+ShadowScene::ShadowScene(std::shared_ptr<const LoadedScene> scene) : scene_(std::move(scene)) {
   proxy_ = std::make_unique<RayScene>();
-  if (room_.triangle_count() > 0) proxy_->add_static(room_);
+  if (scene_->room.triangle_count() > 0) proxy_->add_static(scene_->room);
   proxy_->commit();
-  for (const SceneObject& o : scene.objects) objects_.push_back({o.name, load_mesh(o.mesh), o.T_world_model});
 }
+
+ShadowScene::ShadowScene(LoadedScene scene) : ShadowScene(std::make_shared<const LoadedScene>(std::move(scene))) {}
+
+namespace {
+LoadedScene scene_of_parts(EnvironmentMap map, bool distant, Mesh room_world, std::vector<LoadedObject> objects,
+                           ShadowRegions regions) {
+  LoadedScene s;
+  s.manifest.distant_map = distant;
+  s.manifest.shadows = std::move(regions);
+  if (room_world.triangle_count() > 0) {
+    const auto [lo, hi] = room_world.bounds();
+    s.manifest.movement_min = glm::dvec3(lo), s.manifest.movement_max = glm::dvec3(hi);
+  }
+  s.map = std::move(map);
+  s.room = std::move(room_world);
+  s.objects = std::move(objects);
+  return s;
+}
+}  // namespace
 
 ShadowScene::ShadowScene(EnvironmentMap map, bool distant, Mesh room_world, std::vector<Object> objects,
                          ShadowRegions regions)
-    : map_(std::move(map)),
-      distant_(distant),
-      room_(std::move(room_world)),
-      objects_(std::move(objects)),
-      regions_(std::move(regions)) {
-  proxy_ = std::make_unique<RayScene>();
-  if (room_.triangle_count() > 0) proxy_->add_static(room_);
-  proxy_->commit();
-  if (room_.triangle_count() > 0) {
-    const auto [lo, hi] = room_.bounds();
-    movement_min_ = glm::dvec3(lo), movement_max_ = glm::dvec3(hi);
-  }
-}
+    : ShadowScene(
+          scene_of_parts(std::move(map), distant, std::move(room_world), std::move(objects), std::move(regions))) {}
 
 Mesh ShadowScene::receivers() const {
-  std::vector<SceneBox> boxes = regions_.receivers;
-  if (boxes.empty()) {
-    Scene s;
-    s.movement_min = movement_min_;
-    s.movement_max = movement_max_;
-    boxes = default_receiver_regions(s, room_);
-  }
-  return build_receivers(*proxy_, boxes, regions_.receiver_vertices);
+  std::vector<SceneBox> boxes = regions().receivers;
+  if (boxes.empty()) boxes = default_receiver_regions(scene_->manifest, scene_->room);
+  return build_receivers(*proxy_, boxes, regions().receiver_vertices);
 }
 
 Emitters ShadowScene::emitters(const std::vector<glm::vec3>& positions, const std::vector<glm::vec3>& normals,
@@ -180,13 +174,13 @@ Emitters ShadowScene::emitters(const std::vector<glm::vec3>& positions, const st
   for (std::size_t i = 0; i < positions.size(); ++i) c += glm::dvec3(positions[i]), n += glm::dvec3(normals[i]);
   if (!positions.empty()) c /= double(positions.size());
   const glm::vec3 normal = glm::length(n) > 1e-9 ? glm::vec3(glm::normalize(n)) : glm::vec3(0, 1, 0);
-  if (options.regions.empty()) options.regions = regions_.emitters;
-  return build_emitters(map_, *proxy_, distant_, glm::vec3(c), normal, options);
+  if (options.regions.empty()) options.regions = regions().emitters;
+  return build_emitters(map(), *proxy_, distant(), glm::vec3(c), normal, options);
 }
 
 std::unique_ptr<RayScene> ShadowScene::occluders() const {
   auto s = std::make_unique<RayScene>();
-  for (const Object& o : objects_) s->add_instance(o.model, o.T_world_model);
+  for (const Object& o : objects()) s->add_instance(o.model, o.T_world_model);
   s->commit();
   return s;
 }

@@ -11,7 +11,7 @@
 #include "lumar/pipeline/live_lighting.h"
 #include "lumar/render/compositor.h"
 #include "lumar/render/platform/context.h"
-#include "lumar/scene/scene.h"
+#include "lumar/scene/loaded_scene.h"
 
 namespace lumar::app {
 
@@ -48,7 +48,7 @@ class ReplayOverlay {
   void run(int max_frames, const std::function<bool(const OverlayFrame&)>& sink);
 
   const capture::RecordingReplay& replay() const { return replay_; }
-  const Scene& scene() const { return scene_; }
+  const LoadedScene& scene() const { return *scene_; }
   Compositor& compositor() { return *compositor_; }
   gl::WindowContext* window() { return window_; }
   const StageTimes& times() const { return times_; }
@@ -57,7 +57,7 @@ class ReplayOverlay {
 
  private:
   capture::RecordingReplay replay_;
-  Scene scene_;
+  std::shared_ptr<const LoadedScene> scene_;
   PoseSource pose_source_;
   std::unique_ptr<gl::Context> context_;
   gl::WindowContext* window_ = nullptr;

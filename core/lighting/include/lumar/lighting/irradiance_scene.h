@@ -7,13 +7,18 @@
 
 #include "lumar/lighting/irradiance_volume.h"
 #include "lumar/lighting/room_radiance.h"
-#include "lumar/scene/scene.h"
+#include "lumar/scene/loaded_scene.h"
 
 namespace lumar {
 
 // Named settings (volume_settings_for) with the manifest's lighting.irradiance knobs.
 VolumeSettings scene_volume_settings(const LightingSettings& lighting, const std::string& method);
-// Loads the map (with capture point and azimuth offset) and, unless distant, the proxy.
-std::unique_ptr<RoomRadiance> scene_radiance(const Scene& scene, const RadianceSettings& settings);
+// The room's radiance: the scene's map on its proxy, or by direction alone when distant.
+std::unique_ptr<RoomRadiance> scene_radiance(const LoadedScene& scene, const RadianceSettings& settings);
+// The scene's irradiance volume over its movement box with `method`'s settings, loaded
+// from the cache (cache_dir; empty: the default) when it holds one built from the same
+// inputs, else built (and stored, unless use_cache is false). `loaded` says which.
+IrradianceVolume scene_irradiance_volume(const LoadedScene& scene, const std::string& method, bool use_cache = true,
+                                         const std::filesystem::path& cache_dir = {}, bool* loaded = nullptr);
 
 }  // namespace lumar

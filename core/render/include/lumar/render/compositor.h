@@ -10,7 +10,7 @@
 #include "lumar/base/camera.h"
 #include "lumar/lighting/sh.h"
 #include "lumar/render/renderer.h"
-#include "lumar/scene/scene.h"
+#include "lumar/scene/loaded_scene.h"
 
 namespace lumar {
 
@@ -23,7 +23,8 @@ class Compositor {
   // `output_camera`: the undistorted camera the renderer draws with. `map_x`, `map_y`:
   // for each output pixel, where to sample the distorted video (may be empty when the
   // video is already undistorted).
-  Compositor(const Scene& scene, const CameraIntrinsics& output_camera, const cv::Mat& map_x, const cv::Mat& map_y);
+  Compositor(std::shared_ptr<const LoadedScene> scene, const CameraIntrinsics& output_camera, const cv::Mat& map_x,
+             const cv::Mat& map_y);
 
   // Composites one BGR8 video frame seen from T_world_camera (nullopt: no pose, the
   // undistorted video alone); `exposure` is the video's linear value per unit of scene radiance.
@@ -42,6 +43,7 @@ class Compositor {
   const ObjectShadows* object_shadows() const { return object_shadows_.get(); }
 
   gl::Renderer& renderer() { return *renderer_; }
+  const LoadedScene& scene() const { return *scene_; }
   const CameraIntrinsics& output_camera() const { return camera_; }
   const SH9& lighting_sh() const { return sh_; }
   // The irradiance volume that shades the objects per pixel (built for the scene's
@@ -53,10 +55,11 @@ class Compositor {
 
  private:
   CameraIntrinsics camera_;
+  std::shared_ptr<const LoadedScene> scene_;
   SH9 sh_;
   std::unique_ptr<gl::Renderer> renderer_;
   std::shared_ptr<IrradianceVolume> volume_;  // shared_ptr: incomplete here
-  void build_shadows(const Scene& scene);
+  void build_shadows();
   std::vector<glm::dvec3> object_points_;
   std::shared_ptr<LineShadows> shadows_;  // shared_ptr: LineShadows is incomplete here
   std::shared_ptr<ObjectShadows> object_shadows_;

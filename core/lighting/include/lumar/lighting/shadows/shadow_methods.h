@@ -15,8 +15,8 @@
 #include "lumar/lighting/shadows/shadow_emitters.h"
 #include "lumar/lighting/shadows/shadow_lines.h"
 #include "lumar/scene/envmap.h"
+#include "lumar/scene/loaded_scene.h"
 #include "lumar/scene/mesh.h"
-#include "lumar/scene/scene.h"
 
 namespace lumar {
 
@@ -46,27 +46,26 @@ enum class ShadowMethod { Lines, Reference, Sphere };
 // "lines", "reference" or "sphere"; throws InputError otherwise.
 ShadowMethod parse_shadow_method(const std::string& name);
 
-// What every method needs from a scene manifest: the map, the proxy room (world), the
-// virtual objects in their poses.
+// What every method needs from a scene: the map, the proxy room (world, and as rays),
+// the virtual objects in their poses.
 class ShadowScene {
  public:
-  struct Object {
-    std::string name;
-    Mesh model;
-    glm::dmat4 T_world_model{1.0};
-  };
+  using Object = LoadedObject;
 
-  explicit ShadowScene(const Scene& scene);
-  // Parts built in code (tests): a map, a world-space proxy (may be empty), objects.
+  explicit ShadowScene(std::shared_ptr<const LoadedScene> scene);
+  explicit ShadowScene(LoadedScene scene);
+  // Parts built in code (tests): a map, a world-space proxy (may be empty), objects; the
+  // movement box is the proxy's bounds.
   ShadowScene(EnvironmentMap map, bool distant, Mesh room_world, std::vector<Object> objects,
               ShadowRegions regions = {});
 
-  const EnvironmentMap& map() const { return map_; }
-  bool distant() const { return distant_; }
-  const Mesh& room() const { return room_; }
+  const LoadedScene& scene() const { return *scene_; }
+  const EnvironmentMap& map() const { return scene_->map; }
+  bool distant() const { return scene_->distant(); }
+  const Mesh& room() const { return scene_->room; }
   const RayScene& proxy() const { return *proxy_; }
-  const std::vector<Object>& objects() const { return objects_; }
-  const ShadowRegions& regions() const { return regions_; }
+  const std::vector<Object>& objects() const { return scene_->objects; }
+  const ShadowRegions& regions() const { return scene_->manifest.shadows; }
 
   // The receiver mesh: the manifest's receiver boxes, or the floor under the movement box.
   Mesh receivers() const;
@@ -77,13 +76,8 @@ class ShadowScene {
   std::unique_ptr<RayScene> occluders() const;
 
  private:
-  EnvironmentMap map_;
-  bool distant_ = false;
-  Mesh room_;
+  std::shared_ptr<const LoadedScene> scene_;
   std::unique_ptr<RayScene> proxy_;
-  std::vector<Object> objects_;
-  ShadowRegions regions_;
-  glm::dvec3 movement_min_{0.0}, movement_max_{0.0};
 };
 
 struct ShadowMethodOptions {
