@@ -26,7 +26,7 @@ void register_overlay(CLI::App& app) {
       app.add_subcommand("overlay", "Composite virtual objects into a recording's video (headless or in a window)");
   cmd->add_option("--recording", o->recording, "Recording directory (video + tracker stream + session.json)");
   // The live path (live_overlay.h): --source and --tracker instead of --recording.
-  auto live = std::make_shared<LiveOverlayOptions>();
+  auto live = std::make_shared<pipeline::LiveOverlayOptions>();
   cmd->add_option("--source", live->in.source, "Live: video:FILE, images:DIR, v4l2:/dev/videoN or recording:DIR");
   cmd->add_option("--rig", live->rig, "Live: a session.json whose rig (transmitter, camera offset) to use");
   add_live_input_options(cmd, live->in);
@@ -54,7 +54,7 @@ void register_overlay(CLI::App& app) {
       if (!o->recording.empty()) throw InputError("overlay: give --recording or --source, not both");
       live->scene = o->scene;
       live->max_frames = o->max_frames;
-      return run_live_overlay(*live);
+      return pipeline::run_live_overlay(*live);
     }
     if (o->recording.empty()) throw InputError("overlay: give --recording DIR, or --source SPEC for the live path");
     if (o->out.empty() && o->frames_dir.empty() && o->contact_sheet.empty() && !o->window)
@@ -64,12 +64,13 @@ void register_overlay(CLI::App& app) {
     const auto undistortion = o->undistort == "crop"   ? calib::UndistortedCamera::CropToValid
                               : o->undistort == "keep" ? calib::UndistortedCamera::KeepAll
                                                        : calib::UndistortedCamera::SameMatrix;
-    ReplayOverlay overlay(o->recording, o->scene, o->poses == "truth" ? PoseSource::Truth : PoseSource::Tracker,
-                          o->window, undistortion, o->adapt_lighting);
+    pipeline::ReplayOverlay overlay(o->recording, o->scene,
+                                    o->poses == "truth" ? pipeline::PoseSource::Truth : pipeline::PoseSource::Tracker,
+                                    o->window, undistortion, o->adapt_lighting);
     const auto& camera = overlay.compositor().output_camera();
     const double fps = overlay.replay().reader().video().fps;
-    std::optional<VideoOutput> video;
-    std::optional<FramesOutput> frames;
+    std::optional<pipeline::VideoOutput> video;
+    std::optional<pipeline::FramesOutput> frames;
     if (!o->out.empty()) video.emplace(o->out, fps, cv::Size(camera.width, camera.height));
     if (!o->frames_dir.empty()) frames.emplace(o->frames_dir);
     // Eight frames spread evenly over the run, for the contact sheet.
@@ -77,7 +78,7 @@ void register_overlay(CLI::App& app) {
     if (o->max_frames > 0) total = std::min<std::int64_t>(total, o->max_frames);
     std::vector<std::pair<std::int64_t, cv::Mat>> sheet;
     std::int64_t seen = 0;
-    overlay.run(o->max_frames, [&](const OverlayFrame& f) {
+    overlay.run(o->max_frames, [&](const pipeline::OverlayFrame& f) {
       if (!o->contact_sheet.empty() && int(sheet.size()) < 8 && seen * 7 >= std::int64_t(sheet.size()) * (total - 1))
         sheet.emplace_back(f.index, f.composite.clone());
       ++seen;
@@ -92,7 +93,7 @@ void register_overlay(CLI::App& app) {
     });
     if (video) video->commit();
     if (frames) frames->commit();
-    if (!o->contact_sheet.empty()) write_contact_sheet(o->contact_sheet, sheet);
+    if (!o->contact_sheet.empty()) pipeline::write_contact_sheet(o->contact_sheet, sheet);
     const auto& stats = overlay.replay().tracker_stats();
     spdlog::info("overlay: {} frames{}{}; tracker: {} records, {} rejected, {} bytes skipped", overlay.times().frames,
                  o->out.empty() ? "" : " -> " + o->out, video ? " (" + video->codec() + ")" : "", stats.records,
@@ -102,7 +103,7 @@ void register_overlay(CLI::App& app) {
                    lighting->measurements());
     if (overlay.frames_without_pose() > 0)
       spdlog::warn("overlay: {} frames had no tracker pose and show the video alone", overlay.frames_without_pose());
-    spdlog::info("{}", format_stage_times(overlay.times()));
+    spdlog::info("{}", pipeline::format_stage_times(overlay.times()));
   });
 }
 

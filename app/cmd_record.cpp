@@ -25,7 +25,7 @@ namespace lumar::app {
 namespace {
 
 struct RecordOptions {
-  LiveInputOptions in;
+  pipeline::LiveInputOptions in;
   std::string out;
   std::string codec = "mjpeg";
   int quality = 95;
@@ -50,16 +50,16 @@ void run_record(const RecordOptions& o) {
   if (std::error_code ec; std::filesystem::exists(o.out, ec))
     throw InputError(o.out + ": already exists; choose a new recording directory");
 
-  LiveSource live = open_live_source(o.in);
+  pipeline::LiveSource live = pipeline::open_live_source(o.in);
   const cv::Size size = live.source->frame_size();
   double fps = live.source->nominal_fps();
   if (!(fps > 0)) fps = 30;
-  const CameraIntrinsics camera = live_camera(o.in, size.width, size.height);
+  const CameraIntrinsics camera = pipeline::live_camera(o.in, size.width, size.height);
 
   capture::RecordingWriter* writer_ptr = nullptr;
   Nanos start = 0;
   std::atomic<std::uint64_t> raw_errors{0};
-  auto driver = make_tracker_driver(o.in, [&](const tracking::ByteChunk& chunk) {
+  auto driver = pipeline::make_tracker_driver(o.in, [&](const tracking::ByteChunk& chunk) {
     if (!writer_ptr) return;
     try {
       writer_ptr->add_tracker_bytes({chunk.arrival - start, chunk.bytes});
@@ -74,9 +74,9 @@ void run_record(const RecordOptions& o) {
   video.fps = fps;
   video.size = size;
   video.frames_per_segment = std::max(1, int(std::lround(fps * o.segment_seconds)));
-  capture::RecordingWriter writer(o.out, live_session(o.in, camera, driver.get()), video);
+  capture::RecordingWriter writer(o.out, pipeline::live_session(o.in, camera, driver.get()), video);
 
-  catch_stop_signals();
+  pipeline::catch_stop_signals();
   start = monotonic_now();
   writer_ptr = &writer;
   if (driver) driver->start();
@@ -106,7 +106,7 @@ void run_record(const RecordOptions& o) {
   try {
     const Nanos end = o.duration_s > 0 ? start + seconds_to_nanos(o.duration_s) : 0;
     capture::Frame frame;
-    while (!stop_requested() && (end == 0 || monotonic_now() < end) &&
+    while (!pipeline::stop_requested() && (end == 0 || monotonic_now() < end) &&
            (o.max_frames <= 0 || int(frames) < o.max_frames)) {
       if (queue.pop(frame, 50'000'000)) {
         frame.time -= start;

@@ -91,7 +91,7 @@ Outcome regress_one(const fs::path& dir, bool update) {
   std::vector<std::int64_t> golden;
   if (!update) golden = expected.at("golden_frames").get<std::vector<std::int64_t>>();
 
-  ReplayOverlay overlay(dir, "", PoseSource::Tracker, false);
+  pipeline::ReplayOverlay overlay(dir, "", pipeline::PoseSource::Tracker, false);
   const auto& frames = overlay.replay().reader().frames();
   if (frames.empty()) throw InputError(dir.string() + ": recording holds no frames");
   if (overlay.replay().reader().truth().empty()) throw InputError(dir.string() + ": regression needs truth.csv");
@@ -103,7 +103,7 @@ Outcome regress_one(const fs::path& dir, bool update) {
   std::map<std::int64_t, cv::Mat> outputs;
   std::vector<double> tracked_errors;
   const auto& points = overlay.compositor().object_points();
-  overlay.run(0, [&](const OverlayFrame& f) {
+  overlay.run(0, [&](const pipeline::OverlayFrame& f) {
     if (std::find(golden.begin(), golden.end(), f.index) != golden.end()) {
       cv::Mat small;
       cv::resize(f.composite, small, kGoldenSize, 0, 0, cv::INTER_AREA);

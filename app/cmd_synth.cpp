@@ -11,8 +11,28 @@
 
 namespace lumar::app {
 
+namespace {
+// --sweep: a recording of a map alone, for `lumar envmap` (sim/synthetic_sweep.h).
+struct SweepOptions {
+  sim::SweepSynthSettings settings;
+  std::string envmap, exposures = "0,-5,-10";
+  bool sweep = false;
+};
+
+void add_sweep_options(CLI::App* cmd, SweepOptions& o) {
+  cmd->add_flag("--sweep", o.sweep, "Render a sweep of an environment map alone (for `lumar envmap`); needs --envmap");
+  cmd->add_option("--envmap", o.envmap, "--sweep: the lat-long HDR map (OpenEXR or Radiance HDR)");
+  cmd->add_option("--exposures", o.exposures, "--sweep: exposures in stops relative to 18 % grey, e.g. 0,-5,-10")
+      ->capture_default_str();
+  cmd->add_option("--exposure-mode", o.settings.exposure_mode,
+                  "--sweep: bracket (stop and take every exposure) or cycle (one exposure per frame while moving)")
+      ->check(CLI::IsMember({"bracket", "cycle"}))
+      ->capture_default_str();
+}
+}  // namespace
+
 void register_synth(CLI::App& app) {
-  auto s = std::make_shared<SynthSettings>();
+  auto s = std::make_shared<sim::SynthSettings>();
   auto camera_file = std::make_shared<std::string>();
   auto* cmd =
       app.add_subcommand("synth", "Render a synthetic recording (video + tracker stream + true poses) of a scene");
@@ -44,7 +64,7 @@ void register_synth(CLI::App& app) {
   cmd->add_option("--quality", s->quality, "MJPEG quality")->check(CLI::Range(50, 100))->capture_default_str();
   cmd->add_option("--seed", s->seed, "Random seed for noise")->capture_default_str();
   // --board: the tracked camera filming a checkerboard, for `lumar calibrate-rig`.
-  auto b = std::make_shared<BoardSynthSettings>();
+  auto b = std::make_shared<sim::BoardSynthSettings>();
   auto board = std::make_shared<std::string>();
   cmd->add_option("--board", *board, "Render a checkerboard recording instead: inner corners WxH, e.g. 9x6");
   cmd->add_option("--square", b->square, "--board: square size in metres")->capture_default_str();
@@ -53,9 +73,18 @@ void register_synth(CLI::App& app) {
                   "--board: the tracker latency session.json claims (the device's is --latency-ms)")
       ->capture_default_str();
   cmd->add_option("--image-noise", b->image_noise, "--board: image noise, 8-bit levels RMS")->capture_default_str();
-  add_sweep_options(cmd);  // --sweep: synthetic_sweep.h
-  add_action(cmd, [cmd, s, camera_file, b, board] {
-    if (run_sweep_if_requested(cmd, *camera_file, *s)) return;
+  auto sweep = std::make_shared<SweepOptions>();
+  add_sweep_options(cmd, *sweep);
+  add_action(cmd, [cmd, s, camera_file, b, board, sweep] {
+    if (sweep->sweep) {
+      if (sweep->envmap.empty()) throw InputError("synth --sweep: give the map to sweep with --envmap MAP.exr");
+      sim::SweepSynthSettings settings = sweep->settings;
+      settings.envmap = sweep->envmap;
+      settings.exposure_stops = sim::parse_exposure_stops(sweep->exposures);
+      s->camera = calib::load_camera_file(*camera_file).intrinsics;
+      sim::synthesize_sweep(*s, settings);
+      return;
+    }
     if (!board->empty()) {
       int w = 0, h = 0;
       char x = 0, extra = 0;
@@ -72,12 +101,12 @@ void register_synth(CLI::App& app) {
       if (given("--latency-ms")) b->latency_ms = s->latency_ms;
       if (given("--codec")) b->codec = s->codec;
       b->seed = s->seed;
-      synthesize_board_recording(*b);
+      sim::synthesize_board_recording(*b);
       return;
     }
     if (s->scene.empty()) throw InputError("synth: give --scene (or --board for a checkerboard recording)");
     s->camera = calib::load_camera_file(*camera_file).intrinsics;
-    synthesize_recording(*s);
+    sim::synthesize_recording(*s);
   });
 }
 

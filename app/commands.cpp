@@ -1,6 +1,7 @@
 #include "commands.h"
 
 #include <map>
+#include <string>
 
 namespace lumar::app {
 
@@ -12,6 +13,24 @@ std::map<CLI::App*, std::function<void()>>& actions() {
 }  // namespace
 
 void add_action(CLI::App* sub, std::function<void()> run) { actions()[sub] = std::move(run); }
+
+void add_live_input_options(CLI::App* cmd, pipeline::LiveInputOptions& o, const std::string& camera_help) {
+  cmd->add_option("--timestamps", o.timestamps, "images: a file,time_ns table of the frames");
+  cmd->add_option("--images-fps", o.images_fps, "images: fixed frame rate when there is no table");
+  cmd->add_option("--video-width", o.width, "v4l2: frame width to ask for")->capture_default_str();
+  cmd->add_option("--video-height", o.height, "v4l2: frame height to ask for")->capture_default_str();
+  cmd->add_option("--camera-fps", o.camera_fps, "v4l2: frame rate to ask for")->capture_default_str();
+  cmd->add_option("--format", o.pixel_format, "v4l2: pixel format (YUYV or MJPG; default: YUYV, then MJPG)");
+  cmd->add_option("--v4l2-exposure", o.exposure_100us, "v4l2: exposure in 100 us units (default: leave)");
+  cmd->add_option("--gain", o.gain, "v4l2: sensor gain (default: leave)");
+  cmd->add_flag("--auto-exposure", o.auto_exposure, "v4l2: leave auto exposure on (radiometry assumes it is locked)");
+  cmd->add_option("--tracker", o.tracker, "Tracker on a serial port, e.g. serial:/dev/ttyUSB0 (default: none)");
+  cmd->add_option("--tracker-device", o.tracker_model, "Tracker: isotrak2 or fastrak")->capture_default_str();
+  cmd->add_option("--baud", o.baud, "Tracker line speed")->capture_default_str();
+  cmd->add_option("--latency-ms", o.latency_ms, "Tracker device latency, subtracted from pose times")
+      ->capture_default_str();
+  cmd->add_option("--camera", o.camera_file, camera_help);
+}
 
 void register_commands(CLI::App& app) {
   register_synth(app);

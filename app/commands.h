@@ -3,6 +3,9 @@
 // subcommand and the action to run when the user chose it.
 #include <CLI/CLI.hpp>
 #include <functional>
+#include <string>
+
+#include "lumar/pipeline/live_inputs.h"
 
 namespace lumar::app {
 
@@ -11,6 +14,10 @@ void register_commands(CLI::App& app);
 void run_selected(CLI::App& app);
 // Used by the register_* functions.
 void add_action(CLI::App* subcommand, std::function<void()> run);
+// The live inputs' options (all but --source), with the same names in every command.
+void add_live_input_options(
+    CLI::App* cmd, pipeline::LiveInputOptions& o,
+    const std::string& camera_help = "Camera calibration (OpenCV YAML); default: a nominal pinhole");
 
 void register_synth(CLI::App& app);
 void register_overlay(CLI::App& app);

@@ -38,8 +38,8 @@ const Sweep& sweep() {
     s.source = load_environment_map(LUMAR_SOURCE_DIR "/../shared/data/envmaps/courtyard.exr");
     s.camera = calib::load_camera_file(LUMAR_SOURCE_DIR "/data/camera/webcam-640x480.yml").intrinsics;
     const double base = 0.18 / mean_luminance(s.source);
-    const calib::EnvmapViewRenderer view(s.camera);
-    const calib::SensorModel sensor;
+    const sim::EnvmapViewRenderer view(s.camera);
+    const sim::SensorModel sensor;
     const double stops[3] = {4, -1, -6};
     std::mt19937_64 random(11);
     std::normal_distribution<double> normal(0.0, glm::radians(0.75) / std::sqrt(3.0));
@@ -50,7 +50,7 @@ const Sweep& sweep() {
       s.tracker.push_back(glm::normalize(rotation_exp({normal(random), normal(random), normal(random)}) * truth));
       s.groups.push_back(k / 3);
       s.exposures.push_back(base * std::exp2(stops[k % 3]));
-      s.frames.push_back(calib::expose_8bit(view.render(s.source, truth), s.camera, sensor, s.exposures.back(), rng));
+      s.frames.push_back(sim::expose_8bit(view.render(s.source, truth), s.camera, sensor, s.exposures.back(), rng));
     }
     return s;
   }();
@@ -61,8 +61,8 @@ calib::StitchSettings settings(int width) {
   calib::StitchSettings st;
   st.width = width;
   st.camera = sweep().camera;
-  st.vignetting_a = calib::SensorModel{}.vignetting_a;
-  st.vignetting_b = calib::SensorModel{}.vignetting_b;
+  st.vignetting_a = sim::SensorModel{}.vignetting_a;
+  st.vignetting_b = sim::SensorModel{}.vignetting_b;
   return st;
 }
 

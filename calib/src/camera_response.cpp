@@ -153,4 +153,10 @@ void save_camera_response(const std::filesystem::path& path, const CameraRespons
   write_file_atomically(path, j.dump() + "\n");
 }
 
+std::optional<CameraResponse> calibrated_response(const capture::Radiometry& radiometry,
+                                                  const std::filesystem::path& recording) {
+  if (radiometry.response.empty() || radiometry.response == "srgb") return std::nullopt;
+  return load_camera_response(recording / radiometry.response);  // an absolute path stays absolute
+}
+
 }  // namespace lumar::calib

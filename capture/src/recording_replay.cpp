@@ -5,13 +5,17 @@
 
 namespace lumar::capture {
 
-RecordingReplay::RecordingReplay(const std::filesystem::path& dir) : reader_(dir), session_(reader_.session()) {
+RecordingReplay::RecordingReplay(const std::filesystem::path& dir,
+                                 const std::optional<tracking::PoseFilterSettings>& filter)
+    : reader_(dir), session_(reader_.session()) {
   const TrackerSettings& t = session_.tracker;
   const auto decoded = tracking::decode_tracker_stream(reader_.tracker_chunks(&stats_.torn_bytes),
                                                        tracker_format_of(t, (dir / kSessionFile).string()), t.baud,
                                                        session_.rig.latency);
+  std::optional<tracking::PoseSampleFilter> filtered;
+  if (filter) filtered.emplace(*filter);
   for (const auto& sample : decoded.samples)
-    if (sample.station == t.station) poses_.add(sample);
+    if (sample.station == t.station) poses_.add(filtered ? filtered->filter(sample) : sample);
   stats_.records = decoded.records;
   stats_.rejected_records = decoded.rejected_records;
   stats_.skipped_bytes = decoded.skipped_bytes;

@@ -39,7 +39,7 @@ EnvironmentMap analytic_map(int width, double azimuth_offset_deg) {
   return map;
 }
 
-calib::StitchSettings settings_for(const CameraIntrinsics& camera, const calib::SensorModel& sensor, int width) {
+calib::StitchSettings settings_for(const CameraIntrinsics& camera, const sim::SensorModel& sensor, int width) {
   calib::StitchSettings s;
   s.width = width;
   s.camera = camera;
@@ -54,9 +54,9 @@ TEST(EnvmapStitcher, NoiseFreeSweepOfAnAnalyticMapLandsOnTheRightTexels) {
   // several percent.
   const EnvironmentMap source = analytic_map(256, 30.0);
   const CameraIntrinsics camera = test::webcam();
-  calib::SensorModel sensor;
+  sim::SensorModel sensor;
   sensor.read_noise = 0, sensor.shot_noise_gain = 0;
-  const calib::EnvmapViewRenderer view(camera);
+  const sim::EnvmapViewRenderer view(camera);
   auto settings = settings_for(camera, sensor, 256);
   settings.azimuth_offset_deg = 30.0;
   calib::EnvmapStitcher stitcher(settings);
@@ -64,7 +64,7 @@ TEST(EnvmapStitcher, NoiseFreeSweepOfAnAnalyticMapLandsOnTheRightTexels) {
   const double exposure = 0.35;
   for (int k = 0; k < 40; ++k) {
     const glm::dquat R = calib::sweep_rotation((k + 0.5) / 40);
-    stitcher.add_frame(calib::expose_8bit(view.render(source, R), camera, sensor, exposure, rng), R, exposure);
+    stitcher.add_frame(sim::expose_8bit(view.render(source, R), camera, sensor, exposure, rng), R, exposure);
   }
   const EnvironmentMap result = stitcher.current_map();
   const cv::Mat coverage = stitcher.coverage();
@@ -95,15 +95,15 @@ TEST(EnvmapStitcher, ShortExposuresRecoverWhatLongOnesClip) {
       if (glm::dot(latlong_pixel_direction(c, r, 256, 128), lamp) > std::cos(glm::radians(8.0)))
         for (int ch = 0; ch < 3; ++ch) source.rgb[(std::size_t(r) * 256 + c) * 3 + ch] = 3000.f;
   const CameraIntrinsics camera = test::webcam();
-  calib::SensorModel sensor;
-  const calib::EnvmapViewRenderer view(camera);
+  sim::SensorModel sensor;
+  const sim::EnvmapViewRenderer view(camera);
   auto stitch = [&](const std::vector<double>& exposures) {
     calib::EnvmapStitcher stitcher(settings_for(camera, sensor, 256));
     cv::RNG rng(3);
     for (int k = 0; k < 36; ++k) {
       const glm::dquat R = calib::sweep_rotation((k + 0.5) / 36);
       const double e = exposures[k % exposures.size()];
-      stitcher.add_frame(calib::expose_8bit(view.render(source, R), camera, sensor, e, rng), R, e);
+      stitcher.add_frame(sim::expose_8bit(view.render(source, R), camera, sensor, e, rng), R, e);
     }
     return stitcher.current_map();
   };

@@ -56,7 +56,7 @@ const Sweep& synthetic_sweep(const SweepSpec& spec) {
   Sweep sweep;
   sweep.source = load_environment_map(shared_dir() / "data/envmaps" / (spec.map + ".exr"));
   sweep.camera = webcam();
-  const calib::EnvmapViewRenderer view(sweep.camera);
+  const sim::EnvmapViewRenderer view(sweep.camera);
   const double base = auto_exposure(sweep.source);
   std::mt19937_64 random(spec.seed);
   std::normal_distribution<double> normal(0.0, glm::radians(spec.tracker_noise_deg) / std::sqrt(3.0));
@@ -71,7 +71,7 @@ const Sweep& synthetic_sweep(const SweepSpec& spec) {
     sweep.tracker.push_back(glm::normalize(rotation_exp(noise) * truth));
     sweep.exposures.push_back(exposure);
     sweep.frames.push_back(
-        calib::expose_8bit(view.render(sweep.source, truth), sweep.camera, sweep.sensor, exposure, rng));
+        sim::expose_8bit(view.render(sweep.source, truth), sweep.camera, sweep.sensor, exposure, rng));
   }
   return cache.emplace(key, std::move(sweep)).first->second;
 }

@@ -27,7 +27,7 @@ struct SweepSpec {
 struct Sweep {
   EnvironmentMap source;
   CameraIntrinsics camera;
-  calib::SensorModel sensor;
+  sim::SensorModel sensor;
   std::vector<cv::Mat> frames;      // CV_8UC3 BGR
   std::vector<double> exposures;    // video linear value per unit radiance
   std::vector<glm::dquat> truth;    // R_world_camera

@@ -1,6 +1,7 @@
 #include "lumar/tracking/one_euro_filter.h"
 
 #include <cmath>
+#include <cstdio>
 #include <numbers>
 #include <string>
 
@@ -61,6 +62,30 @@ PoseSample PoseSampleFilter::filter(PoseSample sample) {
   auto it = by_station_.try_emplace(sample.station, settings_).first;
   sample.T_transmitter_sensor = it->second.filter(sample.T_transmitter_sensor, sample.time);
   return sample;
+}
+
+std::optional<PoseFilterSettings> parse_pose_filter(const std::string& text, const std::string& option) {
+  if (text == "none") return std::nullopt;
+  PoseFilterSettings s;
+  if (text == "one-euro") return s;
+  const std::string prefix = "one-euro:";
+  const auto bad = [&] {
+    return InputError(option + " " + text +
+                      ": expected none, one-euro or one-euro:MIN_CUTOFF_HZ,BETA (e.g. one-euro:0.05,3)");
+  };
+  if (text.rfind(prefix, 0) != 0) throw bad();
+  double min_cutoff = 0, beta = 0;
+  char comma = 0, extra = 0;
+  if (std::sscanf(text.c_str() + prefix.size(), "%lf%c%lf%c", &min_cutoff, &comma, &beta, &extra) != 3 || comma != ',')
+    throw bad();
+  s.rotation.min_cutoff_hz = s.position.min_cutoff_hz = min_cutoff;
+  s.rotation.beta = s.position.beta = beta;
+  try {
+    validate_one_euro(s.rotation, "the filter");
+  } catch (const InputError& e) {
+    throw InputError(option + " " + text + ": " + e.what());
+  }
+  return s;
 }
 
 }  // namespace lumar::tracking

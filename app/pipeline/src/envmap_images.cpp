@@ -15,7 +15,7 @@
 #include "lumar/calib/camera_response.h"
 #include "lumar/capture/image_sequence_source.h"
 
-namespace lumar::app {
+namespace lumar::pipeline {
 
 namespace fs = std::filesystem;
 
@@ -236,4 +236,4 @@ void export_sweep_images(const SweepInput& in, const std::string& dir_text) {
       dir_text, in.stitch.vignetting_a, in.stitch.vignetting_b);
 }
 
-}  // namespace lumar::app
+}  // namespace lumar::pipeline

@@ -14,34 +14,7 @@
 #include "lumar/capture/recording_replay.h"
 #include "lumar/pipeline/stop_signal.h"
 
-namespace lumar::app {
-
-void add_live_envmap_options(CLI::App* cmd, LiveEnvmapOptions& o) {
-  LiveInputOptions& in = o.in;
-  cmd->add_option("--source", in.source,
-                  "Live sweep: video:FILE | images:DIR_OR_GLOB | v4l2:/dev/videoN | recording:DIR (files play in "
-                  "real time)");
-  cmd->add_option("--rig", o.rig, "--source: a session.json whose rig (tracker to camera) to use (default: identity)");
-  add_live_input_options(cmd, in,
-                         "Camera calibration (OpenCV YAML): --images needs it; --recording: instead of the session's; "
-                         "--source: default a nominal pinhole");
-  cmd->add_option("--frame-exposure", o.exposures,
-                  "--source: video linear value per unit radiance; a list E1,E2,... is cycled over the frames (a "
-                  "recording: its own)")
-      ->delimiter(',');
-  cmd->add_option("--update-every", o.update_every_s, "--source: rewrite the outputs every this many seconds")
-      ->capture_default_str();
-  cmd->add_option("--duration", o.duration_s, "--source: stop after this many seconds (0: end of source or Ctrl-C)");
-  cmd->add_flag("--refine-at-end", o.refine_at_end,
-                "--source: keep the frames and, when the sweep ends, refine their rotations and stitch them again");
-  cmd->add_option("--keep-frames", o.keep_frames, "--source --refine-at-end: most frames kept in memory")
-      ->capture_default_str();
-  cmd->add_option("--tracker-timeout", o.tracker_timeout_s,
-                  "--source: seconds to wait for the tracker's first pose before giving up")
-      ->capture_default_str();
-  cmd->add_option("--max-wait-ms", o.max_wait_ms, "--source: longest a frame waits for the tracker's pose")
-      ->capture_default_str();
-}
+namespace lumar::pipeline {
 
 namespace {
 
@@ -97,9 +70,7 @@ void run_live_envmap(const LiveEnvmapOptions& o) {
     if (st.camera.width != size.width || st.camera.height != size.height)
       throw InputError(o.in.source + ": the session's calibration does not match the frames' size; give --camera");
     const auto dir = std::filesystem::path(o.in.source.substr(std::string("recording:").size()));
-    st.response = session.radiometry.response.empty() || session.radiometry.response == "srgb"
-                      ? calib::srgb_response(1.0)
-                      : calib::load_camera_response(dir / session.radiometry.response);
+    st.response = calib::calibrated_response(session.radiometry, dir).value_or(calib::srgb_response(1.0));
     st.vignetting_a = session.radiometry.vignetting_a;
     st.vignetting_b = session.radiometry.vignetting_b;
     exposures =
@@ -280,4 +251,4 @@ void run_live_envmap(const LiveEnvmapOptions& o) {
                        " frames); check the tracker (--tracker, --rig, --latency-ms) and start the sweep again");
 }
 
-}  // namespace lumar::app
+}  // namespace lumar::pipeline

@@ -17,7 +17,7 @@
 #include "lumar/envmap/hole_filling.h"
 #include "lumar/envmap/orientation_refinement.h"
 
-namespace lumar::app {
+namespace lumar::pipeline {
 
 void check_map_width(int width) {
   if (width <= 0 || width % 2 != 0 || width > 16384)
@@ -140,4 +140,4 @@ void stitch_sweep(const SweepInput& in, const EnvmapOutputOptions& o) {
                          o.reference.empty() ? in.default_reference : o.reference);
 }
 
-}  // namespace lumar::app
+}  // namespace lumar::pipeline

@@ -4,7 +4,7 @@
 
 #include "lumar/calib/vignetting.h"
 
-namespace lumar::app {
+namespace lumar::pipeline {
 
 namespace {
 constexpr int kShrink = 4;
@@ -64,4 +64,4 @@ double LiveLighting::update(gl::Renderer& renderer, const cv::Mat& video_bgr8, c
   return scale();
 }
 
-}  // namespace lumar::app
+}  // namespace lumar::pipeline

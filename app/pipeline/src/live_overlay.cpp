@@ -13,7 +13,7 @@
 #include "lumar/render/platform/context.h"
 #include "lumar/scene/loaded_scene.h"
 
-namespace lumar::app {
+namespace lumar::pipeline {
 
 void run_live_overlay(const LiveOverlayOptions& o) {
   if (o.scene.empty()) throw InputError("overlay: the live path needs --scene");
@@ -73,4 +73,4 @@ void run_live_overlay(const LiveOverlayOptions& o) {
   }
 }
 
-}  // namespace lumar::app
+}  // namespace lumar::pipeline

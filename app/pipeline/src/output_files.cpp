@@ -7,7 +7,7 @@
 #include "lumar/base/error.h"
 #include "lumar/calib/image_file.h"
 
-namespace lumar::app {
+namespace lumar::pipeline {
 
 namespace fs = std::filesystem;
 
@@ -70,4 +70,4 @@ void write_contact_sheet(const fs::path& png, const std::vector<std::pair<std::i
   calib::write_image_atomically(png, sheet);
 }
 
-}  // namespace lumar::app
+}  // namespace lumar::pipeline

@@ -7,18 +7,11 @@
 #include "lumar/calib/camera_response.h"
 #include "lumar/calib/undistortion.h"
 
-namespace lumar::app {
+namespace lumar::pipeline {
 
 namespace {
 double ms_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-}
-
-// The session's response: "srgb" or a response JSON, relative to the recording.
-std::optional<calib::CameraResponse> session_response(const capture::Radiometry& radiometry,
-                                                      const std::filesystem::path& recording) {
-  if (radiometry.response == "srgb") return std::nullopt;
-  return calib::load_camera_response(recording / radiometry.response);  // absolute paths stay absolute
 }
 
 gl::VideoRadiometry video_radiometry(const capture::Radiometry& radiometry, const CameraIntrinsics& camera,
@@ -53,7 +46,7 @@ ReplayOverlay::ReplayOverlay(const std::filesystem::path& recording, const std::
   const calib::UndistortionMaps maps = calib::make_undistortion_maps(camera, undistortion);
   compositor_ = std::make_unique<Compositor>(scene_, maps.output, maps.map_x, maps.map_y);
   const auto& radiometry = replay_.session().radiometry;
-  const auto response = session_response(radiometry, recording);
+  const auto response = calib::calibrated_response(radiometry, recording);
   compositor_->renderer().set_video_radiometry(video_radiometry(radiometry, camera, response));
   if (adapt_lighting_every > 0)
     live_lighting_.emplace(camera, maps, response.value_or(calib::srgb_response(1.0)), radiometry,
@@ -129,4 +122,4 @@ std::string format_stage_times(const StageTimes& t) {
   return text;
 }
 
-}  // namespace lumar::app
+}  // namespace lumar::pipeline

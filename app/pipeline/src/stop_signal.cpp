@@ -2,7 +2,7 @@
 
 #include <csignal>
 
-namespace lumar::app {
+namespace lumar::pipeline {
 
 namespace {
 volatile std::sig_atomic_t g_stop = 0;
@@ -19,4 +19,4 @@ void catch_stop_signals() {
 
 bool stop_requested() { return g_stop != 0; }
 
-}  // namespace lumar::app
+}  // namespace lumar::pipeline

@@ -8,7 +8,7 @@
 #include "lumar/base/color.h"
 #include "lumar/base/error.h"
 
-namespace lumar::calib {
+namespace lumar::sim {
 
 EnvmapViewRenderer::EnvmapViewRenderer(const CameraIntrinsics& camera, int supersample)
     : camera_(camera), supersample_(supersample) {
@@ -70,4 +70,4 @@ cv::Mat expose_8bit(const cv::Mat& radiance_bgr, const CameraIntrinsics& camera,
   return out;
 }
 
-}  // namespace lumar::calib
+}  // namespace lumar::sim

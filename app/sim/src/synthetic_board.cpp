@@ -14,7 +14,7 @@
 #include "lumar/tracking/rig.h"
 #include "lumar/tracking/simulated_tracker.h"
 
-namespace lumar::app {
+namespace lumar::sim {
 
 namespace {
 
@@ -220,4 +220,4 @@ void synthesize_board_recording(const BoardSynthSettings& s) {
                s.assumed_latency_ms);
 }
 
-}  // namespace lumar::app
+}  // namespace lumar::sim

@@ -17,7 +17,7 @@
 #include "lumar/tracking/simulated_tracker.h"
 #include "lumar/tracking/tracker_stream.h"
 
-namespace lumar::app {
+namespace lumar::sim {
 
 Pose look_at(const glm::dvec3& eye, const glm::dvec3& target) {
   const glm::dvec3 forward = glm::normalize(target - eye);
@@ -111,12 +111,12 @@ CameraIntrinsics covering_pinhole(const CameraIntrinsics& camera, int supersampl
 // Radiance (linear, scene units) to an 8-bit frame as the camera would record it.
 cv::Mat expose(const cv::Mat& radiance_bgr, const CameraIntrinsics& camera, const SynthSettings& s, double exposure,
                cv::RNG& rng) {
-  calib::SensorModel sensor;
+  SensorModel sensor;
   sensor.read_noise = s.read_noise;
   sensor.shot_noise_gain = s.shot_noise_gain;
   sensor.vignetting_a = s.vignetting_a;
   sensor.vignetting_b = s.vignetting_b;
-  return calib::expose_8bit(radiance_bgr, camera, sensor, exposure, rng);
+  return expose_8bit(radiance_bgr, camera, sensor, exposure, rng);
 }
 
 // Where the camera looks: the foot of the first virtual object (the centre of its
@@ -216,4 +216,4 @@ void synthesize_recording(const SynthSettings& s) {
                tracker.noisy_samples.size());
 }
 
-}  // namespace lumar::app
+}  // namespace lumar::sim

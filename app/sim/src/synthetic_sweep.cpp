@@ -6,7 +6,6 @@
 #include <sstream>
 
 #include "lumar/base/error.h"
-#include "lumar/calib/camera_file.h"
 #include "lumar/capture/recording_writer.h"
 #include "lumar/capture/session.h"
 #include "lumar/envmap/sweep_path.h"
@@ -14,7 +13,7 @@
 #include "lumar/sim/envmap_view.h"
 #include "lumar/tracking/simulated_tracker.h"
 
-namespace lumar::app {
+namespace lumar::sim {
 
 namespace {
 
@@ -129,12 +128,12 @@ void synthesize_sweep(const SynthSettings& s, const SweepSynthSettings& sw) {
       session, session.rig.latency, s.tracker_noise_deg, s.position_noise_m, s.seed,
       [&](Nanos t) { return session.rig.sensor_pose(true_camera(t)); }, duration);
 
-  calib::SensorModel sensor;
+  SensorModel sensor;
   sensor.read_noise = s.read_noise;
   sensor.shot_noise_gain = s.shot_noise_gain;
   sensor.vignetting_a = s.vignetting_a;
   sensor.vignetting_b = s.vignetting_b;
-  const calib::EnvmapViewRenderer view(s.camera, s.supersample);
+  const EnvmapViewRenderer view(s.camera, s.supersample);
 
   const capture::RecordingSettings video{
       .codec = s.codec, .quality = s.quality, .fps = s.fps, .size = cv::Size(s.camera.width, s.camera.height)};
@@ -142,48 +141,10 @@ void synthesize_sweep(const SynthSettings& s, const SweepSynthSettings& sw) {
       s.out, session, tracker, video, s.frames, s.seed, [&](int k) { return timing.frame_time(k); }, true_camera,
       [&](int k, Nanos, const Pose& T_world_camera, cv::RNG& rng) {
         const double exposure = exposures[std::size_t(k) % exposures.size()];
-        return calib::expose_8bit(view.render(map, T_world_camera.rotation), s.camera, sensor, exposure, rng);
+        return expose_8bit(view.render(map, T_world_camera.rotation), s.camera, sensor, exposure, rng);
       });
   spdlog::info("synth: wrote {} ({} frames, {} exposures, {} mode)", s.out.string(), s.frames, exposures.size(),
                sw.exposure_mode);
 }
 
-namespace {
-struct SweepOptions {
-  SweepSynthSettings settings;
-  std::string envmap, exposures = "0,-5,-10";
-  bool sweep = false;
-};
-std::shared_ptr<SweepOptions>& sweep_options() {
-  static std::shared_ptr<SweepOptions> options;
-  return options;
-}
-}  // namespace
-
-void add_sweep_options(CLI::App* cmd) {
-  auto o = std::make_shared<SweepOptions>();
-  sweep_options() = o;
-  cmd->add_flag("--sweep", o->sweep, "Render a sweep of an environment map alone (for `lumar envmap`); needs --envmap");
-  cmd->add_option("--envmap", o->envmap, "--sweep: the lat-long HDR map (OpenEXR or Radiance HDR)");
-  cmd->add_option("--exposures", o->exposures, "--sweep: exposures in stops relative to 18 % grey, e.g. 0,-5,-10")
-      ->capture_default_str();
-  cmd->add_option("--exposure-mode", o->settings.exposure_mode,
-                  "--sweep: bracket (stop and take every exposure) or cycle (one exposure per frame while moving)")
-      ->check(CLI::IsMember({"bracket", "cycle"}))
-      ->capture_default_str();
-}
-
-bool run_sweep_if_requested(CLI::App* /*synth*/, const std::string& camera_file, SynthSettings shared) {
-  const auto& o = sweep_options();
-  if (!o || !o->sweep) return false;
-  if (o->envmap.empty()) throw InputError("synth --sweep: give the map to sweep with --envmap MAP.exr");
-  SweepSynthSettings settings = o->settings;
-  settings.envmap = o->envmap;
-  settings.exposure_stops = parse_exposure_stops(o->exposures);
-  shared.camera = calib::load_camera_file(camera_file).intrinsics;
-
-  synthesize_sweep(shared, settings);
-  return true;
-}
-
-}  // namespace lumar::app
+}  // namespace lumar::sim

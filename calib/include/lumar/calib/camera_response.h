@@ -7,7 +7,10 @@
 #include <array>
 #include <filesystem>
 #include <opencv2/core.hpp>
+#include <optional>
 #include <vector>
+
+#include "lumar/capture/session.h"
 
 namespace lumar::calib {
 
@@ -45,6 +48,12 @@ cv::Mat linearize(const cv::Mat& image8, const CameraResponse& response);
 // Throws InputError naming the file when it is missing, malformed, or a table is not
 // 256 finite, non-negative, non-decreasing values.
 CameraResponse load_camera_response(const std::filesystem::path& path);
+
+// The response a recording's session names: nullopt for "srgb" (the documented default,
+// srgb_response), else the response file, a path relative to the recording's folder
+// (absolute paths stay absolute). InputError naming the file when it cannot be read.
+std::optional<CameraResponse> calibrated_response(const capture::Radiometry& radiometry,
+                                                  const std::filesystem::path& recording);
 // Writes atomically (temporary file, then rename).
 void save_camera_response(const std::filesystem::path& path, const CameraResponse& response);
 

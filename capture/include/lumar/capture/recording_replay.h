@@ -9,6 +9,7 @@
 #include "lumar/capture/frame_source.h"
 #include "lumar/capture/recording_reader.h"
 #include "lumar/capture/session.h"
+#include "lumar/tracking/one_euro_filter.h"
 #include "lumar/tracking/pose_stream.h"
 
 namespace lumar::capture {
@@ -20,7 +21,10 @@ struct TrackerReplayStats {
 class RecordingReplay {
  public:
   // Throws InputError naming the file when the recording or its session is unusable.
-  explicit RecordingReplay(const std::filesystem::path& dir);
+  // `filter`: the tracker's samples pass through it in the order they arrived, as on the
+  // live path (tracking/one_euro_filter.h).
+  explicit RecordingReplay(const std::filesystem::path& dir,
+                           const std::optional<tracking::PoseFilterSettings>& filter = std::nullopt);
 
   const RecordingReader& reader() const { return reader_; }
   const Session& session() const { return session_; }

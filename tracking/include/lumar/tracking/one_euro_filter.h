@@ -17,6 +17,7 @@
 // With beta = 0 both are plain exponential smoothing with cutoff min_cutoff.
 #include <map>
 #include <optional>
+#include <string>
 
 #include "lumar/base/pose.h"
 #include "lumar/base/time.h"
@@ -77,5 +78,10 @@ class PoseSampleFilter {
   PoseFilterSettings settings_;
   std::map<int, OneEuroPoseFilter> by_station_;
 };
+
+// The pose filter as the command line names it: "none" (nullopt), "one-euro" (the
+// defaults above), or "one-euro:MIN_CUTOFF_HZ,BETA" (both for rotation and position).
+// InputError naming `option` for anything else.
+std::optional<PoseFilterSettings> parse_pose_filter(const std::string& text, const std::string& option = "--filter");
 
 }  // namespace lumar::tracking

@@ -18,7 +18,7 @@
 
 #include "lumar/pipeline/envmap_sweep.h"
 
-namespace lumar::app {
+namespace lumar::pipeline {
 
 struct ImagesInputOptions {
   std::string images;    // folder or glob
@@ -40,4 +40,4 @@ SweepInput images_sweep_input(const ImagesInputOptions& options, int width);
 // exist; it appears complete or not at all.
 void export_sweep_images(const SweepInput& input, const std::string& dir);
 
-}  // namespace lumar::app
+}  // namespace lumar::pipeline

@@ -12,14 +12,13 @@
 // `--source recording:DIR` without --tracker replays the recording's own tracker stream
 // (and takes its camera, radiometry and per-frame exposures): a sweep recorded earlier,
 // played through the live path.
-#include <CLI/CLI.hpp>
 #include <string>
 #include <vector>
 
 #include "lumar/pipeline/envmap_sweep.h"
 #include "lumar/pipeline/live_inputs.h"
 
-namespace lumar::app {
+namespace lumar::pipeline {
 
 struct LiveEnvmapOptions {
   LiveInputOptions in;      // source, tracker, camera calibration (in.camera_file)
@@ -39,11 +38,7 @@ struct LiveEnvmapOptions {
   double tracker_timeout_s = 10;    // the tracker's first pose must come within this (capture starts then)
 };
 
-// The live options that do not clash with the file inputs' (--width is the map's, so
-// the camera's frame size is --video-width / --video-height).
-void add_live_envmap_options(CLI::App* cmd, LiveEnvmapOptions& o);
-
 // Throws InputError / RuntimeError with one line; the outputs written so far stay valid.
 void run_live_envmap(const LiveEnvmapOptions& options);
 
-}  // namespace lumar::app
+}  // namespace lumar::pipeline

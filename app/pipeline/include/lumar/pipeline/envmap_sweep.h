@@ -15,7 +15,7 @@
 #include "lumar/envmap/envmap_stitcher.h"
 #include "lumar/scene/envmap.h"
 
-namespace lumar::app {
+namespace lumar::pipeline {
 
 // What the user asked for, common to every input.
 struct EnvmapOutputOptions {
@@ -74,4 +74,4 @@ class Progress {
   int last_tenth_ = -1;
 };
 
-}  // namespace lumar::app
+}  // namespace lumar::pipeline

@@ -2,7 +2,6 @@
 // The inputs of the live commands (`lumar record`, `lumar overlay --source`): a frame
 // source given as a spec (capture/source_spec.h) and a tracker on a serial port, with
 // the options they share, and the session.json that describes them.
-#include <CLI/CLI.hpp>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <string>
@@ -12,7 +11,7 @@
 #include "lumar/tracking/rig.h"
 #include "lumar/tracking/tracker_driver.h"
 
-namespace lumar::app {
+namespace lumar::pipeline {
 
 struct LiveInputOptions {
   std::string source;             // video:FILE | images:DIR_OR_GLOB | v4l2:/dev/videoN | recording:DIR
@@ -29,11 +28,6 @@ struct LiveInputOptions {
   double latency_ms = 0;    // device latency, subtracted from pose times
   std::string camera_file;  // OpenCV YAML intrinsics (empty: nominal pinhole)
 };
-
-// The options of LiveInputOptions except the source, with the same names in every command.
-void add_live_input_options(
-    CLI::App* cmd, LiveInputOptions& o,
-    const std::string& camera_help = "Camera calibration (OpenCV YAML); default: a nominal pinhole");
 
 struct LiveSource {
   std::unique_ptr<capture::FrameSource> source;  // CLOCK_MONOTONIC times (files are played in real time)
@@ -58,4 +52,4 @@ tracking::Rig live_rig(const std::string& session_json, double latency_ms);
 nlohmann::json live_session(const LiveInputOptions& o, const CameraIntrinsics& camera,
                             const tracking::TrackerDriver* driver);
 
-}  // namespace lumar::app
+}  // namespace lumar::pipeline

@@ -13,7 +13,7 @@
 #include "lumar/capture/session.h"
 #include "lumar/render/renderer.h"
 
-namespace lumar::app {
+namespace lumar::pipeline {
 
 class LiveLighting {
  public:
@@ -38,4 +38,4 @@ class LiveLighting {
   calib::LightingAdapter adapter_;
 };
 
-}  // namespace lumar::app
+}  // namespace lumar::pipeline

@@ -7,7 +7,7 @@
 
 #include "lumar/pipeline/live_inputs.h"
 
-namespace lumar::app {
+namespace lumar::pipeline {
 
 struct LiveOverlayOptions {
   LiveInputOptions in;
@@ -22,4 +22,4 @@ struct LiveOverlayOptions {
 // InputError / RuntimeError with one line (e.g. the camera vanished).
 void run_live_overlay(const LiveOverlayOptions& options);
 
-}  // namespace lumar::app
+}  // namespace lumar::pipeline

@@ -9,7 +9,7 @@
 
 #include "lumar/base/output_file.h"
 
-namespace lumar::app {
+namespace lumar::pipeline {
 
 class VideoOutput {
  public:
@@ -40,4 +40,4 @@ class FramesOutput {
 void write_contact_sheet(const std::filesystem::path& png, const std::vector<std::pair<std::int64_t, cv::Mat>>& frames,
                          int columns = 4, int tile_width = 320);
 
-}  // namespace lumar::app
+}  // namespace lumar::pipeline

@@ -13,7 +13,7 @@
 #include "lumar/render/platform/context.h"
 #include "lumar/scene/loaded_scene.h"
 
-namespace lumar::app {
+namespace lumar::pipeline {
 
 enum class PoseSource { Tracker, Truth };
 
@@ -70,4 +70,4 @@ class ReplayOverlay {
 // One line per stage: mean milliseconds per frame and share of the total.
 std::string format_stage_times(const StageTimes& t);
 
-}  // namespace lumar::app
+}  // namespace lumar::pipeline

@@ -10,7 +10,7 @@
 #include "lumar/base/camera.h"
 #include "lumar/scene/envmap.h"
 
-namespace lumar::calib {
+namespace lumar::sim {
 
 class EnvmapViewRenderer {
  public:
@@ -45,4 +45,4 @@ struct SensorModel {
 cv::Mat expose_8bit(const cv::Mat& radiance_bgr, const CameraIntrinsics& camera, const SensorModel& sensor,
                     double exposure, cv::RNG& rng);
 
-}  // namespace lumar::calib
+}  // namespace lumar::sim

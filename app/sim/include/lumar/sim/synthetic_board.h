@@ -13,7 +13,7 @@
 #include "lumar/base/camera.h"
 #include "lumar/base/pose.h"
 
-namespace lumar::app {
+namespace lumar::sim {
 
 struct BoardSynthSettings {
   std::filesystem::path out;
@@ -47,4 +47,4 @@ cv::Mat render_board_image(const CameraIntrinsics& camera, cv::Size board, doubl
 // InputError / RuntimeError; on failure the partial recording directory is removed.
 void synthesize_board_recording(const BoardSynthSettings& settings);
 
-}  // namespace lumar::app
+}  // namespace lumar::sim

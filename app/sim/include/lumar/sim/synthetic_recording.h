@@ -15,7 +15,7 @@
 #include "lumar/capture/session.h"
 #include "lumar/tracking/simulated_tracker.h"
 
-namespace lumar::app {
+namespace lumar::sim {
 
 struct SynthSettings {
   std::filesystem::path scene;
@@ -73,4 +73,4 @@ Pose orbit_camera_pose(const glm::dvec3& target, double s, double arc_deg);
 // InputError / RuntimeError; on failure the partial recording directory is removed.
 void synthesize_recording(const SynthSettings& settings);
 
-}  // namespace lumar::app
+}  // namespace lumar::sim

@@ -11,14 +11,13 @@
 // at each station and takes the n exposures there (frames k = m n .. m n + n - 1), then
 // moves on while no frame is taken; in "cycle" mode it moves steadily and the exposure
 // changes every frame.
-#include <CLI/CLI.hpp>
 #include <filesystem>
 #include <string>
 #include <vector>
 
 #include "lumar/sim/synthetic_recording.h"
 
-namespace lumar::app {
+namespace lumar::sim {
 
 struct SweepSynthSettings {
   std::filesystem::path envmap;
@@ -36,9 +35,4 @@ std::vector<double> parse_exposure_stops(const std::string& text);
 // Throws InputError / RuntimeError; on failure the partial recording is removed.
 void synthesize_sweep(const SynthSettings& shared, const SweepSynthSettings& sweep);
 
-// The --sweep options of `lumar synth`, and the branch of its action that runs them.
-void add_sweep_options(CLI::App* synth);
-// True when --sweep was given (and the sweep was written).
-bool run_sweep_if_requested(CLI::App* synth, const std::string& camera_file, SynthSettings shared);
-
-}  // namespace lumar::app
+}  // namespace lumar::sim
