@@ -1,5 +1,7 @@
-// lumar overlay: composite the scene's virtual objects into a recording's video.
+// lumar overlay: composite the scene's virtual objects into a recording's video
+// (pipeline/replay_overlay.h), or live into a camera's (pipeline/live_overlay.h).
 #include <spdlog/spdlog.h>
+
 #include <memory>
 #include <optional>
 
@@ -12,30 +14,113 @@
 namespace lumar::app {
 
 namespace {
+
 struct OverlayOptions {
   std::string recording, scene, out, frames_dir, contact_sheet, poses = "tracker", undistort = "same";
+  std::string filter = "none";
   bool window = false;
   int max_frames = 0;
   int adapt_lighting = 0;
+  pipeline::LiveOverlayOptions live;  // --source and what only the live path reads
 };
+
+pipeline::OverlaySettings overlay_settings(const OverlayOptions& o, bool window) {
+  pipeline::OverlaySettings s;
+  s.undistortion = o.undistort == "crop"   ? calib::UndistortedCamera::CropToValid
+                   : o.undistort == "keep" ? calib::UndistortedCamera::KeepAll
+                                           : calib::UndistortedCamera::SameMatrix;
+  s.adapt_lighting_every = o.adapt_lighting;
+  s.window = window;
+  return s;
+}
+
+// Writes every frame to the outputs and shows it in the window, if there is one.
+auto frame_sink(pipeline::Overlay& overlay, pipeline::OverlayOutputs& outputs) {
+  return [&](const pipeline::OverlayFrame& f) {
+    outputs.write(f.index, f.composite);
+    if (auto* w = overlay.window()) {
+      w->present(f.composite);
+      w->poll_events();
+      return !w->should_close();
+    }
+    return true;
+  };
+}
+
+void report(const pipeline::Overlay& overlay) {
+  if (const auto* lighting = overlay.live_lighting())
+    spdlog::info("overlay: lighting scale {:.3f} after {} comparisons of the video with the map", lighting->scale(),
+                 lighting->measurements());
+  if (overlay.frames_without_pose() > 0)
+    spdlog::warn("overlay: {} frames had no tracker pose and show the video alone", overlay.frames_without_pose());
+  spdlog::info("{}", pipeline::format_stage_times(overlay.times()));
+}
+
+void run_live(OverlayOptions& o) {
+  if (!o.recording.empty()) throw InputError("overlay: give --recording or --source, not both");
+  if (!o.contact_sheet.empty()) throw InputError("--contact-sheet: a live run has no known length; use --frames-dir");
+  if (o.poses != "tracker") throw InputError("--poses truth: a live source has no ground truth");
+  pipeline::LiveOverlayOptions& live = o.live;
+  live.scene = o.scene;
+  live.max_frames = o.max_frames;
+  live.filter = tracking::parse_pose_filter(o.filter);
+  // A window unless the frames go to files only.
+  const bool window = o.window || (o.out.empty() && o.frames_dir.empty());
+  live.overlay = overlay_settings(o, window);
+  live.overlay.window_title = "lumar overlay (live)";
+  pipeline::LiveOverlay overlay(live);
+  const auto& camera = overlay.overlay().compositor().output_camera();
+  pipeline::OverlayOutputs outputs({o.out, o.frames_dir, "", overlay.fps(), cv::Size(camera.width, camera.height)});
+  overlay.run(frame_sink(overlay.overlay(), outputs));
+  outputs.commit();
+  report(overlay.overlay());
+}
+
+void run_replay(const OverlayOptions& o) {
+  if (o.recording.empty()) throw InputError("overlay: give --recording DIR, or --source SPEC for the live path");
+  if (o.out.empty() && o.frames_dir.empty() && o.contact_sheet.empty() && !o.window)
+    throw InputError("overlay: nothing to do; give --out, --frames-dir, --contact-sheet or --window");
+  if (!o.live.rig.empty() || o.live.response || o.live.vignetting_a || o.live.vignetting_b || o.live.exposure)
+    throw InputError(
+        "overlay --recording: --rig, --response, --vignetting and --exposure are for --source; a "
+        "recording's session.json already says them");
+  pipeline::ReplayOverlaySettings settings;
+  settings.scene = o.scene;
+  settings.poses = o.poses == "truth" ? pipeline::PoseSource::Truth : pipeline::PoseSource::Tracker;
+  settings.filter = tracking::parse_pose_filter(o.filter);
+  settings.overlay = overlay_settings(o, o.window);
+  pipeline::ReplayOverlay overlay(o.recording, settings);
+  const auto& camera = overlay.compositor().output_camera();
+  std::int64_t total = std::int64_t(overlay.replay().reader().frames().size());
+  if (o.max_frames > 0) total = std::min<std::int64_t>(total, o.max_frames);
+  pipeline::OverlayOutputs outputs({o.out, o.frames_dir, o.contact_sheet, overlay.replay().reader().video().fps,
+                                    cv::Size(camera.width, camera.height), total});
+  overlay.run(o.max_frames, frame_sink(overlay.overlay(), outputs));
+  outputs.commit();
+  const auto& stats = overlay.replay().tracker_stats();
+  spdlog::info("overlay: {} frames{}; tracker: {} records, {} rejected, {} bytes skipped", overlay.times().frames,
+               outputs.describe(), stats.records, stats.rejected_records, stats.skipped_bytes);
+  report(overlay.overlay());
+}
+
 }  // namespace
 
 void register_overlay(CLI::App& app) {
   auto o = std::make_shared<OverlayOptions>();
-  auto* cmd =
-      app.add_subcommand("overlay", "Composite virtual objects into a recording's video (headless or in a window)");
+  auto* cmd = app.add_subcommand(
+      "overlay",
+      "Composite virtual objects into a recording's video, or live into a camera's (headless or in a window)");
   cmd->add_option("--recording", o->recording, "Recording directory (video + tracker stream + session.json)");
-  // The live path (live_overlay.h): --source and --tracker instead of --recording.
-  auto live = std::make_shared<pipeline::LiveOverlayOptions>();
-  cmd->add_option("--source", live->in.source, "Live: video:FILE, images:DIR, v4l2:/dev/videoN or recording:DIR");
-  cmd->add_option("--rig", live->rig, "Live: a session.json whose rig (transmitter, camera offset) to use");
-  add_live_input_options(cmd, live->in);
   cmd->add_option("--scene", o->scene, "Scene manifest; default: the one the recording's session names");
   cmd->add_option("--out", o->out, "Output video (.mp4, .mkv or .avi)");
   cmd->add_option("--frames-dir", o->frames_dir, "Also write every output frame as PNG into this new folder");
   cmd->add_option("--contact-sheet", o->contact_sheet, "Also write 8 frames spread over the run, tiled, as one PNG");
   cmd->add_option("--poses", o->poses, "Camera poses from the tracker stream or from the recording's ground truth")
       ->check(CLI::IsMember({"tracker", "truth"}))
+      ->capture_default_str();
+  cmd->add_option("--filter", o->filter,
+                  "Pose filter on the tracker's samples: none, one-euro (the setting the filter benchmark chose: "
+                  "docs/tracker_filter_jitter_vs_lag.png) or one-euro:MIN_CUTOFF_HZ,BETA")
       ->capture_default_str();
   cmd->add_option(
          "--undistort", o->undistort,
@@ -47,63 +132,24 @@ void register_overlay(CLI::App& app) {
          "Every N frames, compare the video with the map and follow the room getting brighter or darker (0 = off)")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
-  cmd->add_flag("--window", o->window, "Show the result in a window (needs a display)");
+  cmd->add_flag("--window", o->window,
+                "Show the result in a window (needs a display); the live path shows one unless it writes files");
   cmd->add_option("--max-frames", o->max_frames, "Stop after this many frames (0 = all)")->capture_default_str();
-  add_action(cmd, [o, live] {
-    if (!live->in.source.empty()) {
-      if (!o->recording.empty()) throw InputError("overlay: give --recording or --source, not both");
-      live->scene = o->scene;
-      live->max_frames = o->max_frames;
-      return pipeline::run_live_overlay(*live);
-    }
-    if (o->recording.empty()) throw InputError("overlay: give --recording DIR, or --source SPEC for the live path");
-    if (o->out.empty() && o->frames_dir.empty() && o->contact_sheet.empty() && !o->window)
-      throw InputError("overlay: nothing to do; give --out, --frames-dir, --contact-sheet or --window");
-    if (!o->contact_sheet.empty() && std::filesystem::path(o->contact_sheet).extension() != ".png")
-      throw InputError(o->contact_sheet + ": the contact sheet must be a .png file");
-    const auto undistortion = o->undistort == "crop"   ? calib::UndistortedCamera::CropToValid
-                              : o->undistort == "keep" ? calib::UndistortedCamera::KeepAll
-                                                       : calib::UndistortedCamera::SameMatrix;
-    pipeline::ReplayOverlay overlay(o->recording, o->scene,
-                                    o->poses == "truth" ? pipeline::PoseSource::Truth : pipeline::PoseSource::Tracker,
-                                    o->window, undistortion, o->adapt_lighting);
-    const auto& camera = overlay.compositor().output_camera();
-    const double fps = overlay.replay().reader().video().fps;
-    std::optional<pipeline::VideoOutput> video;
-    std::optional<pipeline::FramesOutput> frames;
-    if (!o->out.empty()) video.emplace(o->out, fps, cv::Size(camera.width, camera.height));
-    if (!o->frames_dir.empty()) frames.emplace(o->frames_dir);
-    // Eight frames spread evenly over the run, for the contact sheet.
-    std::int64_t total = std::int64_t(overlay.replay().reader().frames().size());
-    if (o->max_frames > 0) total = std::min<std::int64_t>(total, o->max_frames);
-    std::vector<std::pair<std::int64_t, cv::Mat>> sheet;
-    std::int64_t seen = 0;
-    overlay.run(o->max_frames, [&](const pipeline::OverlayFrame& f) {
-      if (!o->contact_sheet.empty() && int(sheet.size()) < 8 && seen * 7 >= std::int64_t(sheet.size()) * (total - 1))
-        sheet.emplace_back(f.index, f.composite.clone());
-      ++seen;
-      if (video) video->write(f.composite);
-      if (frames) frames->write(f.index, f.composite);
-      if (auto* w = overlay.window()) {
-        w->present(f.composite);
-        w->poll_events();
-        return !w->should_close();
-      }
-      return true;
-    });
-    if (video) video->commit();
-    if (frames) frames->commit();
-    if (!o->contact_sheet.empty()) pipeline::write_contact_sheet(o->contact_sheet, sheet);
-    const auto& stats = overlay.replay().tracker_stats();
-    spdlog::info("overlay: {} frames{}{}; tracker: {} records, {} rejected, {} bytes skipped", overlay.times().frames,
-                 o->out.empty() ? "" : " -> " + o->out, video ? " (" + video->codec() + ")" : "", stats.records,
-                 stats.rejected_records, stats.skipped_bytes);
-    if (const auto* lighting = overlay.live_lighting())
-      spdlog::info("overlay: lighting scale {:.3f} after {} comparisons of the video with the map", lighting->scale(),
-                   lighting->measurements());
-    if (overlay.frames_without_pose() > 0)
-      spdlog::warn("overlay: {} frames had no tracker pose and show the video alone", overlay.frames_without_pose());
-    spdlog::info("{}", pipeline::format_stage_times(overlay.times()));
+  // The live path (pipeline/live_overlay.h): --source and --tracker instead of --recording.
+  pipeline::LiveOverlayOptions& live = o->live;
+  cmd->add_option("--source", live.in.source, "Live: video:FILE, images:DIR, v4l2:/dev/videoN or recording:DIR");
+  cmd->add_option("--rig", live.rig,
+                  "Live: a session.json whose rig, camera calibration and radiometry to use (flags override them)");
+  cmd->add_option("--response", live.response, "Live: camera response JSON, or srgb (default: the --rig session's)");
+  cmd->add_option("--vignetting", live.vignetting_a, "Live: vignetting gain 1 + a r^2 + b r^4, the a term");
+  cmd->add_option("--vignetting-b", live.vignetting_b, "Live: vignetting, the b term");
+  cmd->add_option("--exposure", live.exposure, "Live: video linear value per unit radiance (default: the session's)");
+  cmd->add_option("--max-wait-ms", live.max_wait_ms, "Live: longest a frame waits for the tracker's pose")
+      ->capture_default_str();
+  add_live_input_options(cmd, live.in);
+  add_action(cmd, [o] {
+    if (!o->live.in.source.empty()) return run_live(*o);
+    run_replay(*o);
   });
 }
 

@@ -91,7 +91,7 @@ Outcome regress_one(const fs::path& dir, bool update) {
   std::vector<std::int64_t> golden;
   if (!update) golden = expected.at("golden_frames").get<std::vector<std::int64_t>>();
 
-  pipeline::ReplayOverlay overlay(dir, "", pipeline::PoseSource::Tracker, false);
+  pipeline::ReplayOverlay overlay(dir);
   const auto& frames = overlay.replay().reader().frames();
   if (frames.empty()) throw InputError(dir.string() + ": recording holds no frames");
   if (overlay.replay().reader().truth().empty()) throw InputError(dir.string() + ": regression needs truth.csv");

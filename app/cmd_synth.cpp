@@ -58,6 +58,9 @@ void register_synth(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--latency-ms", s->latency_ms, "Tracker latency in milliseconds")->capture_default_str();
   cmd->add_option("--arc-deg", s->arc_deg, "How far the camera orbits the object, degrees")->capture_default_str();
+  cmd->add_option("--path", s->path, "The camera's path: orbit, or still (held where the orbit ends)")
+      ->check(CLI::IsMember({"orbit", "still"}))
+      ->capture_default_str();
   cmd->add_option("--codec", s->codec, "Video codec: mjpeg (near-lossless) or ffv1 (lossless)")
       ->check(CLI::IsMember({"mjpeg", "ffv1"}))
       ->capture_default_str();

@@ -136,6 +136,7 @@ Session parse_session(const json& j, const std::string& file) {
     synth.read_noise = get_or<double>(y, "read_noise", 0.0, ws);
     synth.shot_noise_gain = get_or<double>(y, "shot_noise_gain", 0.0, ws);
     synth.arc_deg = get_or<double>(y, "arc_deg", 0.0, ws);
+    synth.path = get_or<std::string>(y, "path", "", ws);
     synth.exposure_mode = get_or<std::string>(y, "exposure_mode", "", ws);
     synth.exposure_stops = get_or<std::vector<double>>(y, "exposure_stops", {}, ws);
     synth.seed = get_or<std::uint64_t>(y, "seed", 0, ws);
@@ -213,6 +214,7 @@ json session_to_json(const Session& s) {
               {"shot_noise_gain", y.shot_noise_gain},
               {"seed", y.seed}};
     if (y.arc_deg != 0) o["arc_deg"] = y.arc_deg;
+    if (!y.path.empty()) o["path"] = y.path;
     if (!y.exposure_mode.empty()) o["exposure_mode"] = y.exposure_mode;
     if (!y.exposure_stops.empty()) o["exposure_stops"] = y.exposure_stops;
     j["synth"] = o;

@@ -105,6 +105,20 @@ case_adapt_lighting_follows_the_room() {
   echo "ok: $(cat "$TMP/scale"); frame 8 vs the true session: $adapted levels adapted, $fixed without"
 }
 
+case_live_headless_with_the_sessions_radiometry_and_a_filter() {
+  # The live path on the sample recording played as a camera, with the emulator as the
+  # tracker and the recording's session as the rig: headless, frames written to a folder.
+  start_emulator --rate 60
+  "$LUMAR" overlay --source "recording:$REC" --tracker "serial:$TMP/tty" --rig "$REC/session.json" \
+    --scene "$SRC/data/scenes/room/scene.json" --filter one-euro --adapt-lighting 8 --max-frames 12 \
+    --frames-dir "$TMP/live" >"$TMP/log" 2>&1 || { cat "$TMP/log"; fail "live overlay failed"; }
+  cat "$TMP/log"
+  [ "$(ls "$TMP/live" | wc -l)" -eq 12 ] || fail "expected 12 frames"
+  grep -q "lighting scale" "$TMP/log" || fail "no lighting adaptation on the live path"
+  expect_bad_input "--filter kalman" "" -- "$LUMAR" overlay --recording "$REC" --filter kalman --frames-dir "$TMP/f"
+  expect_bad_input "--rig" "" -- "$LUMAR" overlay --recording "$REC" --rig "$REC/session.json" --frames-dir "$TMP/f"
+}
+
 case_help_describes_every_option() {
   "$LUMAR" --help >"$TMP/h" || fail "lumar --help failed"
   for cmd in synth overlay regress calibrate; do

@@ -15,7 +15,7 @@ std::filesystem::path real_path(const std::filesystem::path& p) { return std::fi
 
 TEST(SceneLoading, AnOverlayRunDecodesEachSceneFileOnce) {
   ASSERT_TRUE(scene_file_decodes().empty());
-  pipeline::ReplayOverlay overlay(test::source_dir() / "recordings/orbit", "", pipeline::PoseSource::Tracker, false);
+  pipeline::ReplayOverlay overlay(test::source_dir() / "recordings/orbit");
   int frames = 0;
   overlay.run(4, [&](const pipeline::OverlayFrame&) { return ++frames > 0; });
   EXPECT_EQ(frames, 4);

@@ -27,6 +27,12 @@ LiveSource open_live_source(const LiveInputOptions& o) {
   return {std::make_unique<capture::RealTimeSource>(std::move(opened.source)), false};
 }
 
+std::shared_ptr<const capture::RecordingReplay> recorded_poses_of(const LiveInputOptions& o) {
+  const std::string prefix = "recording:";
+  if (!o.tracker.empty() || o.source.rfind(prefix, 0) != 0) return nullptr;
+  return std::make_shared<const capture::RecordingReplay>(o.source.substr(prefix.size()));
+}
+
 std::unique_ptr<tracking::TrackerDriver> make_tracker_driver(const LiveInputOptions& o,
                                                              tracking::TrackerDriver::ByteObserver on_bytes) {
   if (o.tracker.empty()) return nullptr;

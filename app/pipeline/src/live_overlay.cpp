@@ -2,75 +2,88 @@
 
 #include <spdlog/spdlog.h>
 
-#include <thread>
+#include <chrono>
 
 #include "lumar/base/error.h"
-#include "lumar/calib/undistortion.h"
-#include "lumar/capture/capture_thread.h"
-#include "lumar/capture/frame_pose_pairing.h"
-#include "lumar/pipeline/stop_signal.h"
-#include "lumar/render/compositor.h"
-#include "lumar/render/platform/context.h"
-#include "lumar/scene/loaded_scene.h"
+#include "lumar/capture/session.h"
 
 namespace lumar::pipeline {
 
-void run_live_overlay(const LiveOverlayOptions& o) {
+LiveOverlay::LiveOverlay(const LiveOverlayOptions& o) {
   if (o.scene.empty()) throw InputError("overlay: the live path needs --scene");
-  const auto scene = std::make_shared<const LoadedScene>(load_scene_files(o.scene));
-  const tracking::Rig rig = live_rig(o.rig.string(), o.in.latency_ms);
-  LiveSource live = open_live_source(o.in);
+  auto scene = std::make_shared<const LoadedScene>(load_scene_files(o.scene));
+
+  // The session that describes the camera: --rig's, else a recording source's own.
+  std::optional<capture::Session> session;
+  std::filesystem::path session_dir;
+  if (!o.rig.empty()) {
+    session = capture::load_session_file(o.rig);
+    session_dir = o.rig.parent_path();
+  } else if (o.in.source.rfind("recording:", 0) == 0) {
+    session_dir = o.in.source.substr(std::string("recording:").size());
+    session = capture::load_session_file(session_dir / "session.json");
+  }
+
+  LiveInputOptions in = o.in;
+  if (session && in.latency_ms == 0) in.latency_ms = nanos_to_seconds(session->rig.latency) * 1e3;
+  LiveSource live = open_live_source(in);
+  fps_ = live.source->nominal_fps() > 0 ? live.source->nominal_fps() : 30.0;
   const cv::Size size = live.source->frame_size();
-  const CameraIntrinsics camera = live_camera(o.in, size.width, size.height);
+  CameraIntrinsics camera = live_camera(in, size.width, size.height);
+  if (in.camera_file.empty() && session && session->camera.width == size.width && session->camera.height == size.height)
+    camera = session->camera;
 
-  capture::FramePosePairing pairing(rig);
-  auto driver = make_tracker_driver(o.in, {});
-  gl::WindowContext window(camera.width, camera.height, "lumar overlay (live)");
-  const calib::UndistortionMaps maps = calib::make_undistortion_maps(camera);
-  Compositor compositor(scene, maps.output, maps.map_x, maps.map_y);
+  capture::Radiometry radiometry = session ? session->radiometry : capture::Radiometry{};
+  std::optional<calib::CameraResponse> response;
+  if (o.response) {
+    radiometry.response = *o.response;
+    response = calib::calibrated_response(radiometry, std::filesystem::current_path());
+  } else if (session) {
+    response = calib::calibrated_response(radiometry, session_dir);
+  }
+  if (o.vignetting_a) radiometry.vignetting_a = *o.vignetting_a;
+  if (o.vignetting_b) radiometry.vignetting_b = *o.vignetting_b;
+  if (o.exposure) radiometry.exposure = *o.exposure;
+  if (!(radiometry.exposure > 0)) throw InputError("--exposure must be a positive number");
 
-  catch_stop_signals();
-  if (driver) driver->start();
-  capture::FrameQueue queue(1, capture::QueuePolicy::KeepNewest);  // always the freshest picture
-  capture::CaptureThread capture(std::move(live.source), queue);
-  std::vector<tracking::PoseSample> samples;
-  std::uint64_t frames = 0, without_pose = 0, extrapolated = 0;
-  const Nanos max_wait = seconds_to_nanos(o.max_wait_ms * 1e-3);
-  while (!stop_requested() && !window.should_close() && (o.max_frames <= 0 || int(frames) < o.max_frames)) {
-    window.poll_events();
-    capture::Frame frame;
-    if (!queue.pop(frame, 50'000'000)) {
-      if (queue.closed()) break;
-      continue;
-    }
-    // Hold the frame briefly until the tracker has a sample past its time: then the
-    // pose is interpolated, not extrapolated.
-    const Nanos deadline = monotonic_now() + max_wait;
-    for (;;) {
-      if (driver) {
-        samples.clear();
-        driver->take_samples(samples);
-        pairing.add(samples);
-      }
-      if (!driver || pairing.covers(frame.time) || monotonic_now() >= deadline) break;
-      std::this_thread::sleep_for(std::chrono::milliseconds(1));
-    }
-    const capture::PairedFrame paired = pairing.pair(std::move(frame));
-    if (!paired.T_world_camera) ++without_pose;
-    if (paired.sensor.status == tracking::PoseStatus::Extrapolated) ++extrapolated;
-    window.present(compositor.composite(paired.frame.image, paired.T_world_camera, o.exposure, nullptr));
-    ++frames;
-    if (frames % 300 == 0) pairing.forget_before(paired.frame.time - kNanosPerSecond);
-  }
-  capture.stop();
-  if (driver) driver->stop();
-  const auto qs = queue.stats();
-  spdlog::info("overlay: {} frames shown, {} stale frames skipped, {} without a pose, {} extrapolated", frames,
-               qs.stale_dropped, without_pose, extrapolated);
-  if (capture.end() == capture::CaptureEnd::Vanished || capture.end() == capture::CaptureEnd::Failed) {
-    if (capture.input_error()) throw InputError(capture.message());
-    throw RuntimeError(capture.message());
-  }
+  tracking::Rig rig = session ? session->rig : tracking::Rig{};
+  rig.latency = seconds_to_nanos(in.latency_ms * 1e-3);
+  auto driver = make_tracker_driver(in, {});
+  const auto recorded = recorded_poses_of(in);
+
+  overlay_ = std::make_unique<Overlay>(std::move(scene), camera, radiometry, response, o.overlay);
+  LiveLoopSettings settings;
+  settings.what = "overlay";
+  settings.policy = capture::QueuePolicy::KeepNewest;  // always the freshest picture
+  settings.queue_frames = 1;
+  settings.max_wait = seconds_to_nanos(o.max_wait_ms * 1e-3);
+  settings.max_frames = o.max_frames;
+  settings.filter = o.filter;
+  loop_ = std::make_unique<LiveLoop>(std::move(live.source), std::move(driver), rig, settings);
+  if (recorded) loop_->use_recorded_poses(recorded);
+}
+
+void LiveOverlay::run(const std::function<bool(const OverlayFrame&)>& sink) {
+  StageTimes& times = overlay_->times();
+  loop_->run(
+      [&](capture::PairedFrame& paired) {
+        const OverlayFrame out = overlay_->composite(paired.frame, paired.T_world_camera);
+        const auto t0 = std::chrono::steady_clock::now();
+        const bool go_on = sink(out);
+        times.output += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+        return go_on;
+      },
+      [&] {
+        if (auto* w = overlay_->window()) {
+          w->poll_events();
+          return !w->should_close();
+        }
+        return true;
+      });
+  const auto& s = loop_->stats();
+  spdlog::info("overlay: {} frames shown, {} stale frames skipped, {} without a pose, {} extrapolated", s.frames,
+               s.queue.stale_dropped, s.without_pose, s.extrapolated);
+  loop_->check_source();
 }
 
 }  // namespace lumar::pipeline

@@ -70,4 +70,31 @@ void write_contact_sheet(const fs::path& png, const std::vector<std::pair<std::i
   calib::write_image_atomically(png, sheet);
 }
 
+OverlayOutputs::OverlayOutputs(const OverlayOutputSettings& s) : settings_(s) {
+  if (!s.contact_sheet.empty() && fs::path(s.contact_sheet).extension() != ".png")
+    throw InputError(s.contact_sheet + ": the contact sheet must be a .png file");
+  if (!s.video.empty()) video_.emplace(s.video, s.fps, s.size);
+  if (!s.frames_dir.empty()) frames_.emplace(s.frames_dir);
+}
+
+void OverlayOutputs::write(std::int64_t index, const cv::Mat& bgr8) {
+  // Eight frames spread evenly over the run, for the contact sheet.
+  const std::int64_t total = settings_.expected_frames;
+  if (!settings_.contact_sheet.empty() && sheet_.size() < 8 && seen_ * 7 >= std::int64_t(sheet_.size()) * (total - 1))
+    sheet_.emplace_back(index, bgr8.clone());
+  ++seen_;
+  if (video_) video_->write(bgr8);
+  if (frames_) frames_->write(index, bgr8);
+}
+
+void OverlayOutputs::commit() {
+  if (video_) video_->commit();
+  if (frames_) frames_->commit();
+  if (!settings_.contact_sheet.empty()) write_contact_sheet(settings_.contact_sheet, sheet_);
+}
+
+std::string OverlayOutputs::describe() const {
+  return video_ ? " -> " + settings_.video + " (" + video_->codec() + ")" : std::string();
+}
+
 }  // namespace lumar::pipeline

@@ -142,6 +142,12 @@ Pose orbit_camera_pose(const glm::dvec3& target, double s, double arc_deg) {
   return look_at(eye, target + glm::dvec3(0, 0.08, 0));
 }
 
+Pose synth_camera_pose(const std::string& path, const glm::dvec3& target, double s, double arc_deg) {
+  if (path == "orbit") return orbit_camera_pose(target, s, arc_deg);
+  if (path == "still") return orbit_camera_pose(target, 1.0, arc_deg);
+  throw InputError("--path " + path + ": unknown camera path; use orbit or still");
+}
+
 void synthesize_recording(const SynthSettings& s) {
   if (s.frames < 2) throw InputError("--frames: need at least 2 frames");
   if (s.fps <= 0) throw InputError("--fps: must be positive");
@@ -174,6 +180,7 @@ void synthesize_recording(const SynthSettings& s) {
   synth.read_noise = s.read_noise;
   synth.shot_noise_gain = s.shot_noise_gain;
   synth.arc_deg = s.arc_deg;
+  synth.path = s.path;
   synth.seed = s.seed;
   session.synth = synth;
 
@@ -184,7 +191,7 @@ void synthesize_recording(const SynthSettings& s) {
   const double clip_seconds = nanos_to_seconds(frame_period * (s.frames - 1));
   auto true_camera = [&](Nanos t) {
     const double u = std::clamp(nanos_to_seconds(t - start) / clip_seconds, 0.0, 1.0);
-    return orbit_camera_pose(target, u, s.arc_deg);
+    return synth_camera_pose(s.path, target, u, s.arc_deg);
   };
 
   const auto tracker = simulate_session_tracker(

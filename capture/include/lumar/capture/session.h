@@ -47,6 +47,7 @@ struct SynthInfo {
   double fps = 0.0;
   double tracker_noise_deg = 0.75, position_noise_m = 0.0, read_noise = 0.0, shot_noise_gain = 0.0;
   double arc_deg = 0.0;                // an orbit's arc
+  std::string path;                    // the camera's path: orbit | still
   std::string exposure_mode;           // a sweep's: bracket | cycle
   std::vector<double> exposure_stops;  // a sweep's
   std::uint64_t seed = 0;

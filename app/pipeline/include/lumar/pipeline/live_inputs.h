@@ -8,6 +8,7 @@
 
 #include "lumar/base/camera.h"
 #include "lumar/capture/frame_source.h"
+#include "lumar/capture/recording_replay.h"
 #include "lumar/tracking/rig.h"
 #include "lumar/tracking/tracker_driver.h"
 
@@ -34,6 +35,10 @@ struct LiveSource {
   bool camera = false;
 };
 LiveSource open_live_source(const LiveInputOptions& o);
+
+// The recording behind a `recording:DIR` source given without --tracker: it brings its
+// own poses (its tracker stream, as a replay decodes it). nullptr otherwise.
+std::shared_ptr<const capture::RecordingReplay> recorded_poses_of(const LiveInputOptions& o);
 
 // The tracker driver for --tracker (nullptr when none was given); nothing is opened
 // before start(). InputError for a port that does not exist or bad settings.

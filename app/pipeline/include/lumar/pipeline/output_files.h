@@ -4,6 +4,8 @@
 #include <filesystem>
 #include <opencv2/core.hpp>
 #include <opencv2/videoio.hpp>
+#include <optional>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -33,6 +35,33 @@ class FramesOutput {
 
  private:
   OutputFolder folder_;
+};
+
+// What `lumar overlay` writes of its frames, whichever path made them: a video, a folder
+// of PNG frames, and a contact sheet of eight frames spread evenly over the run (which
+// needs the run's length, `expected_frames`). Each appears whole at commit() or not at all.
+struct OverlayOutputSettings {
+  std::string video, frames_dir, contact_sheet;  // empty: not written
+  double fps = 30;
+  cv::Size size;
+  std::int64_t expected_frames = 0;
+};
+
+class OverlayOutputs {
+ public:
+  // InputError for a bad path (a contact sheet that is not .png, a folder that exists).
+  explicit OverlayOutputs(const OverlayOutputSettings& settings);
+  void write(std::int64_t index, const cv::Mat& bgr8);
+  void commit();
+  // " -> out.mp4 (avc1)", or "" without a video.
+  std::string describe() const;
+
+ private:
+  OverlayOutputSettings settings_;
+  std::optional<VideoOutput> video_;
+  std::optional<FramesOutput> frames_;
+  std::vector<std::pair<std::int64_t, cv::Mat>> sheet_;
+  std::int64_t seen_ = 0;
 };
 
 // Tiles frames (each scaled to `tile_width`, aspect kept) into rows of `columns`, with

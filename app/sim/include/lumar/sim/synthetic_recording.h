@@ -32,6 +32,7 @@ struct SynthSettings {
   double position_noise_m = 0.0025;  // RMS per axis
   double latency_ms = 20.0;          // device latency
   double arc_deg = 60.0;             // how far the camera orbits
+  std::string path = "orbit";        // orbit | still (held where the orbit ends)
   std::string codec = "mjpeg";
   int quality = 95;
   std::uint64_t seed = 1;
@@ -68,6 +69,9 @@ void write_synthetic_recording(const std::filesystem::path& out, const capture::
 
 // The camera's true pose at s in [0, 1] along the orbit around `target`.
 Pose orbit_camera_pose(const glm::dvec3& target, double s, double arc_deg);
+// The camera's true pose at s in [0, 1] along the named path ("orbit", "still");
+// InputError for another name.
+Pose synth_camera_pose(const std::string& path, const glm::dvec3& target, double s, double arc_deg);
 
 // Writes the recording into settings.out (which must not exist yet). Throws
 // InputError / RuntimeError; on failure the partial recording directory is removed.

@@ -1,0 +1,80 @@
+#pragma once
+// What the replay and the live overlay share, frame by frame: a GL context (a window or
+// headless EGL), the compositor over the undistorted video, the video's radiometry
+// (response, vignetting, exposure: how the camera turned radiance into codes), the
+// lighting adaptation, and the time each stage took.
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "lumar/calib/camera_response.h"
+#include "lumar/calib/undistortion.h"
+#include "lumar/capture/frame_source.h"
+#include "lumar/capture/session.h"
+#include "lumar/pipeline/live_lighting.h"
+#include "lumar/render/compositor.h"
+#include "lumar/render/platform/context.h"
+#include "lumar/scene/loaded_scene.h"
+
+namespace lumar::pipeline {
+
+struct OverlaySettings {
+  calib::UndistortedCamera undistortion = calib::UndistortedCamera::SameMatrix;
+  // > 0: every that many frames, compare the video with the map and scale the objects'
+  // lighting as the room gets brighter or darker (live_lighting.h).
+  int adapt_lighting_every = 0;
+  bool window = false;  // a GLFW window to draw into; else a headless EGL context
+  std::string window_title = "lumar overlay";
+};
+
+struct StageTimes {  // milliseconds, summed over frames
+  double decode = 0, pose = 0, lighting = 0, upload = 0, background = 0, depth = 0, objects = 0, readback = 0,
+         output = 0;
+  int frames = 0;
+};
+
+struct OverlayFrame {
+  std::int64_t index = 0;
+  Nanos time = 0;
+  cv::Mat video;                       // as recorded
+  cv::Mat composite;                   // BGR8 output
+  std::optional<Pose> T_world_camera;  // the pose used (nullopt: no pose, video only)
+  double lighting_scale = 1.0;         // the map's light as the room measured now (1: unchanged)
+};
+
+class Overlay {
+ public:
+  // `camera`: the video's calibration; `radiometry` and `response` (nullopt: sRGB): how
+  // the video was made.
+  Overlay(std::shared_ptr<const LoadedScene> scene, const CameraIntrinsics& camera,
+          const capture::Radiometry& radiometry, const std::optional<calib::CameraResponse>& response,
+          const OverlaySettings& settings);
+  ~Overlay();
+  Overlay(const Overlay&) = delete;
+  Overlay& operator=(const Overlay&) = delete;
+
+  // Adapts the lighting (with a pose, on every n-th call) and composites the frame.
+  OverlayFrame composite(const capture::Frame& frame, const std::optional<Pose>& T_world_camera);
+
+  Compositor& compositor() { return *compositor_; }
+  const LoadedScene& scene() const { return compositor_->scene(); }
+  gl::WindowContext* window() { return window_; }
+  StageTimes& times() { return times_; }  // composite() fills the rendering stages; callers the rest
+  const StageTimes& times() const { return times_; }
+  int frames_without_pose() const { return frames_without_pose_; }
+  const LiveLighting* live_lighting() const { return live_lighting_ ? &*live_lighting_ : nullptr; }
+
+ private:
+  std::unique_ptr<gl::Context> context_;
+  gl::WindowContext* window_ = nullptr;
+  std::unique_ptr<Compositor> compositor_;
+  double exposure_ = 1.0;
+  std::optional<LiveLighting> live_lighting_;
+  StageTimes times_;
+  int frames_without_pose_ = 0;
+};
+
+// One line per stage: mean milliseconds per frame and share of the total.
+std::string format_stage_times(const StageTimes& t);
+
+}  // namespace lumar::pipeline
