@@ -1,25 +1,32 @@
 #pragma once
-// Synthetic checkerboard recordings (`lumar synth --board`) shared by the rig tests.
-// CTest runs every test in its own process, so each recording is made once and cached
-// under the temporary directory, keyed by its arguments and the lumar binary's
-// modification time; it is made under a temporary name and renamed, so concurrent
-// tests never see half a recording.
+// Synthetic checkerboard recordings (sim/synthetic_board.h, what `lumar synth --board`
+// makes) shared by the rig tests. CTest runs every test in its own process, so each
+// recording is made once and cached under the temporary directory, keyed by its settings
+// and the test program's modification time; it is made under a temporary name and
+// renamed, so concurrent tests never see half a recording.
 #include <filesystem>
 #include <string>
 
 #include "lumar/calib/rig_recording.h"
+#include "lumar/sim/synthetic_board.h"
 #include "lumar/tracking/rig.h"
 
 namespace lumar::test {
 
-// `extra_args` are appended to: lumar synth --board 9x6 --square 0.025 --camera <webcam>.
-std::filesystem::path board_recording(const std::string& extra_args);
+// 12 s at 30 fps, the ISOTRAK II's noise (0.75 deg, 0.1 in RMS), 20 ms latency, the
+// session assuming 0 ms; the 9x6 board of 25 mm squares, the calibrated webcam.
+sim::BoardSynthSettings noisy_board();
+// The same motion with a perfect tracker (only its 0.01 deg / 0.01 in quantisation) and
+// 35 ms of latency.
+sim::BoardSynthSettings clean_board();
+
+std::filesystem::path board_recording(const sim::BoardSynthSettings& settings);
 
 // The truth stored by the generator in session.json ("synth_board").
 tracking::Rig board_recording_truth(const std::filesystem::path& recording);
 
 // Loaded once per process and recording.
-const calib::RigRecording& loaded_board_recording(const std::string& extra_args);
+const calib::RigRecording& loaded_board_recording(const sim::BoardSynthSettings& settings);
 
 struct RigErrors {
   double offset_mm = 0, offset_deg = 0;  // T_sensor_camera

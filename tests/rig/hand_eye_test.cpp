@@ -101,7 +101,7 @@ TEST(TimeOffset, FindsAKnownShiftBetweenTwoSpeedSignals) {
 // The renderer and the detector agree with the truth: board poses from solvePnP on the
 // rendered frames against T_camera_board from truth.csv.
 TEST(BoardPose, RenderedFramesGiveTheTruePose) {
-  const std::string args = "--seconds 12";
+  const sim::BoardSynthSettings args = test::noisy_board();
   const auto& rec = test::loaded_board_recording(args);
   const capture::RecordingReader reader(test::board_recording(args));
   const auto truth = reader.truth();

@@ -13,11 +13,8 @@
 namespace lumar {
 namespace {
 
-// 12 s at 30 fps, the ISOTRAK II's noise (0.75 deg, 0.1 in RMS), 20 ms latency, the
-// session assuming 0 ms.
-const std::string kNoisy = "--seconds 12";
-// The same motion with a perfect tracker (only its 0.01 deg / 0.01 in quantisation).
-const std::string kClean = "--seconds 12 --tracker-noise-deg 0 --position-noise-m 0 --latency-ms 35";
+const sim::BoardSynthSettings kNoisy = test::noisy_board();
+const sim::BoardSynthSettings kClean = test::clean_board();
 
 void print(const char* what, const test::RigErrors& e, const calib::RigCalibrationResult& r) {
   std::printf(
