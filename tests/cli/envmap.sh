@@ -335,7 +335,11 @@ case_live_tracker_vanishes() {
   local pid=$!
   PIDS+=("$pid")
   wait_for 20 grep -q "updated" "$TMP/live.log" || { cat "$TMP/live.log"; fail "no map written while running"; }
+  # Unplugged: the device and its node are gone. (The killed emulator cannot remove its
+  # link; left dangling, it would lead the driver to whatever pty takes the freed number
+  # next, another test's emulator when the suite runs in parallel.)
   kill -9 "$EMULATOR"
+  rm -f "$TMP/tty"
   wait "$pid" || { cat "$TMP/live.log"; fail "envmap failed when the tracker vanished"; }
   cat "$TMP/live.log"
   [ "$(grep -c "tracker lost" "$TMP/live.log")" -eq 1 ] || fail "expected exactly one 'tracker lost' line"

@@ -62,6 +62,18 @@ tracking::EmulatorSettings emulator_for(const capture::RecordingReplay& replay) 
 
 double psnr(const cv::Mat& a, const cv::Mat& b) { return std::min(99.0, cv::PSNR(a, b)); }
 
+// The live overlay of the recording `dir` played as a camera, posed by the emulator.
+pipeline::LiveOverlayOptions live_options(const std::filesystem::path& dir, const tracking::TrackerEmulator& emulator) {
+  pipeline::LiveOverlayOptions lo;
+  lo.in.source = "recording:" + dir.string();
+  lo.in.tracker = "serial:" + emulator.port_path();
+  lo.scene = test::source_dir() / "data/scenes/room/scene.json";
+  lo.rig = dir / "session.json";  // rig, camera, radiometry and latency
+  lo.max_wait_ms = 200;           // let the tracker connect before the first frames
+  lo.overlay.window = false;
+  return lo;
+}
+
 struct Compared {
   int frames = 0;
   double worst_psnr = 99.0;
@@ -82,13 +94,7 @@ Compared compare_live_with_replay(const std::filesystem::path& dir, int adapt_li
   });
 
   tracking::TrackerEmulator emulator(emulator_for(replay.replay()));
-  pipeline::LiveOverlayOptions lo;
-  lo.in.source = "recording:" + dir.string();
-  lo.in.tracker = "serial:" + emulator.port_path();
-  lo.scene = test::source_dir() / "data/scenes/room/scene.json";
-  lo.rig = dir / "session.json";  // rig, camera, radiometry and latency
-  lo.max_wait_ms = 200;           // let the tracker connect before the first frames
-  lo.overlay.window = false;
+  pipeline::LiveOverlayOptions lo = live_options(dir, emulator);
   lo.overlay.adapt_lighting_every = adapt_lighting_every;
   pipeline::LiveOverlay live(lo);
   Compared c;
@@ -139,14 +145,8 @@ TEST(LiveOverlay, WithoutTheSessionsRadiometryTheFramesDiffer) {
     return true;
   });
   tracking::TrackerEmulator emulator(emulator_for(replay.replay()));
-  pipeline::LiveOverlayOptions lo;
-  lo.in.source = "recording:" + dir.string();
-  lo.in.tracker = "serial:" + emulator.port_path();
-  lo.scene = test::source_dir() / "data/scenes/room/scene.json";
-  lo.rig = dir / "session.json";
+  pipeline::LiveOverlayOptions lo = live_options(dir, emulator);
   lo.exposure = 1.0;
-  lo.max_wait_ms = 200;
-  lo.overlay.window = false;
   pipeline::LiveOverlay live(lo);
   double psnr_first = 0;
   live.run([&](const pipeline::OverlayFrame& f) {

@@ -142,6 +142,18 @@ Pose orbit_camera_pose(const glm::dvec3& target, double s, double arc_deg) {
   return look_at(eye, target + glm::dvec3(0, 0.08, 0));
 }
 
+capture::SynthInfo synth_info(const SynthSettings& s) {
+  capture::SynthInfo synth;
+  synth.frames = s.frames;
+  synth.fps = s.fps;
+  synth.tracker_noise_deg = s.tracker_noise_deg;
+  synth.position_noise_m = s.position_noise_m;
+  synth.read_noise = s.read_noise;
+  synth.shot_noise_gain = s.shot_noise_gain;
+  synth.seed = s.seed;
+  return synth;
+}
+
 Pose synth_camera_pose(const std::string& path, const glm::dvec3& target, double s, double arc_deg) {
   if (path == "orbit") return orbit_camera_pose(target, s, arc_deg);
   if (path == "still") return orbit_camera_pose(target, 1.0, arc_deg);
@@ -172,17 +184,9 @@ void synthesize_recording(const SynthSettings& s) {
   session.scene =
       std::filesystem::relative(std::filesystem::absolute(s.scene), std::filesystem::absolute(s.out)).string();
   session.source = "lumar synth";
-  capture::SynthInfo synth;
-  synth.frames = s.frames;
-  synth.fps = s.fps;
-  synth.tracker_noise_deg = s.tracker_noise_deg;
-  synth.position_noise_m = s.position_noise_m;
-  synth.read_noise = s.read_noise;
-  synth.shot_noise_gain = s.shot_noise_gain;
-  synth.arc_deg = s.arc_deg;
-  synth.path = s.path;
-  synth.seed = s.seed;
-  session.synth = synth;
+  session.synth = synth_info(s);
+  session.synth->arc_deg = s.arc_deg;
+  session.synth->path = s.path;
 
   const glm::dvec3 target = scene_target(scene);
   const Nanos start = seconds_to_nanos(0.1);  // tracker runs before the first frame

@@ -112,17 +112,9 @@ void synthesize_sweep(const SynthSettings& s, const SweepSynthSettings& sw) {
   session.exposure_bracket = timing.bracket;
   session.envmap =
       capture::SweepInfo{sw.capture_position, map.azimuth_offset_deg, std::filesystem::absolute(sw.envmap).string()};
-  capture::SynthInfo synth;
-  synth.frames = s.frames;
-  synth.fps = s.fps;
-  synth.exposure_mode = sw.exposure_mode;
-  synth.exposure_stops = sw.exposure_stops;
-  synth.tracker_noise_deg = s.tracker_noise_deg;
-  synth.position_noise_m = s.position_noise_m;
-  synth.read_noise = s.read_noise;
-  synth.shot_noise_gain = s.shot_noise_gain;
-  synth.seed = s.seed;
-  session.synth = synth;
+  session.synth = synth_info(s);
+  session.synth->exposure_mode = sw.exposure_mode;
+  session.synth->exposure_stops = sw.exposure_stops;
 
   const auto tracker = simulate_session_tracker(
       session, session.rig.latency, s.tracker_noise_deg, s.position_noise_m, s.seed,

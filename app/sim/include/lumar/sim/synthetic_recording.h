@@ -38,6 +38,9 @@ struct SynthSettings {
   std::uint64_t seed = 1;
 };
 
+// The session's record of the settings every synthetic recording shares ("synth").
+capture::SynthInfo synth_info(const SynthSettings& settings);
+
 // OpenCV camera axes (x right, y down, z forward) looking from `eye` at `target`, world +Y up.
 Pose look_at(const glm::dvec3& eye, const glm::dvec3& target);
 
