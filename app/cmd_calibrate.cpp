@@ -25,7 +25,7 @@ struct CalibrateOptions {
   double square = 0.025;
   std::string out;
   bool json = false;
-  std::string coverage;
+  std::string coverage, preview;
   calib::RobustCalibrationOptions calib;
   bool no_reject = false;
   std::string video;   // --video FILE: the same as --source video:FILE
@@ -99,7 +99,10 @@ void register_calibrate(CLI::App& app) {
   cmd->add_flag("--fix-k3", o->calib.fix_k3, "Keep k3 at 0 (narrow-angle lenses)");
   cmd->add_flag("--fix-aspect", o->calib.fix_aspect, "Solve with fx = fy");
   cmd->add_flag("--no-reject", o->no_reject, "Keep every view (no outlier rejection)");
-  cmd->add_option("--coverage", o->coverage, "Write a PNG of where the corners fell on the sensor");
+  cmd->add_option("--coverage", o->coverage,
+                  "Write a PNG of where the corners fell on the sensor, with a legend and the areas still missing");
+  cmd->add_option("--preview", o->preview,
+                  "Write a PNG of the most distorted view as recorded and undistorted, to judge the result by eye");
   add_action(cmd, [o] {
     if (!o->video.empty()) {
       if (!o->source.empty()) throw InputError("calibrate: give --video or --source, not both");
@@ -125,6 +128,7 @@ void register_calibrate(CLI::App& app) {
     options.reject_outliers = !o->no_reject;
     const auto result = calib::calibrate_robust(views, options);
     if (!o->coverage.empty()) calib::write_coverage_image(o->coverage, views, result, options);
+    if (!o->preview.empty()) calib::write_undistorted_preview(o->preview, images, views, result);
     calib::save_calibration_report(o->out, result, board, o->square);
     for (const auto& w : result.warnings) std::fprintf(stderr, "lumar: warning: %s\n", w.c_str());
     const auto& c = result.camera.intrinsics;

@@ -109,6 +109,11 @@ void register_envmap(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--out", o->out.out, "Output map (OpenEXR, float RGB)");
   cmd->add_option("--width", o->out.width, "Map width in pixels (height = width / 2)")->capture_default_str();
+  cmd->add_option("--min-coverage", o->out.min_coverage,
+                  "Refuse a map whose frames saw less than this share of the sphere (0 to 1; hole filling invents "
+                  "the rest)")
+      ->check(CLI::Range(0.0, 1.0))
+      ->capture_default_str();
   cmd->add_flag("--no-refine", o->out.no_refine, "Use the tracker's rotations as they are");
   cmd->add_flag("--no-fill", o->out.no_fill, "Leave uncovered pixels black instead of filling them");
   cmd->add_option("--coverage", o->out.coverage, "Write a coverage map (PNG): magenta holes, grey by frame count");

@@ -9,6 +9,7 @@
 #include "lumar/base/error.h"
 #include "lumar/pipeline/live_overlay.h"
 #include "lumar/pipeline/output_files.h"
+#include "lumar/pipeline/progress.h"
 #include "lumar/pipeline/replay_overlay.h"
 
 namespace lumar::app {
@@ -18,7 +19,7 @@ namespace {
 struct OverlayOptions {
   std::string recording, scene, out, frames_dir, contact_sheet, poses = "tracker", undistort = "same";
   std::string filter = "none";
-  bool window = false;
+  bool window = false, no_cache = false;
   int max_frames = 0;
   int adapt_lighting = 0;
   pipeline::LiveOverlayOptions live;  // --source and what only the live path reads
@@ -31,6 +32,7 @@ pipeline::OverlaySettings overlay_settings(const OverlayOptions& o, bool window)
                                            : calib::UndistortedCamera::SameMatrix;
   s.adapt_lighting_every = o.adapt_lighting;
   s.window = window;
+  s.volume_cache = !o.no_cache;
   return s;
 }
 
@@ -95,7 +97,15 @@ void run_replay(const OverlayOptions& o) {
   if (o.max_frames > 0) total = std::min<std::int64_t>(total, o.max_frames);
   pipeline::OverlayOutputs outputs({o.out, o.frames_dir, o.contact_sheet, overlay.replay().reader().video().fps,
                                     cv::Size(camera.width, camera.height), total});
-  overlay.run(o.max_frames, frame_sink(overlay.overlay(), outputs));
+  pipeline::Progress progress("overlay", int(total), "frames", true);  // on a terminal only
+  auto sink = frame_sink(overlay.overlay(), outputs);
+  int done = 0;
+  overlay.run(o.max_frames, [&](const pipeline::OverlayFrame& f) {
+    const bool go_on = sink(f);
+    progress.update(++done);
+    return go_on;
+  });
+  progress.finish();
   outputs.commit();
   const auto& stats = overlay.replay().tracker_stats();
   spdlog::info("overlay: {} frames{}; tracker: {} records, {} rejected, {} bytes skipped", overlay.times().frames,
@@ -135,6 +145,8 @@ void register_overlay(CLI::App& app) {
   cmd->add_flag("--window", o->window,
                 "Show the result in a window (needs a display); the live path shows one unless it writes files");
   cmd->add_option("--max-frames", o->max_frames, "Stop after this many frames (0 = all)")->capture_default_str();
+  cmd->add_flag("--no-cache", o->no_cache,
+                "Build the irradiance volume without reading or writing the cache ($XDG_CACHE_HOME/lumar)");
   // The live path (pipeline/live_overlay.h): --source and --tracker instead of --recording.
   pipeline::LiveOverlayOptions& live = o->live;
   cmd->add_option("--source", live.in.source, "Live: video:FILE, images:DIR, v4l2:/dev/videoN or recording:DIR");

@@ -1,9 +1,11 @@
 #!/usr/bin/env bash
-# Configures and builds Lumar. Usage: scripts/build.sh [release|asan|tsan]
-# The build goes to build/<type>/ inside the checkout.
+# Configures and builds Lumar. Usage: scripts/build.sh [release|asan|tsan] [TARGET ...]
+# The build goes to build/<type>/ inside the checkout; with targets, only those (and
+# what they need) are built, e.g. `scripts/build.sh release lumar` for the command alone.
 set -euo pipefail
 top=$(cd "$(dirname "$0")/.." && pwd)
 type=${1:-release}
+shift || true
 case "$type" in
   release) cmake_type=Release ;;
   asan) cmake_type=Asan ;;
@@ -12,5 +14,9 @@ case "$type" in
 esac
 build="$top/build/$type"
 cmake -S "$top" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE="$cmake_type" -DLUMAR_SHARED_DIR="$top/../shared" >/dev/null
-cmake --build "$build" -j"$(nproc)"
-echo "build.sh: built $build"
+if [ $# -gt 0 ]; then
+  cmake --build "$build" -j"$(nproc)" --target "$@"
+else
+  cmake --build "$build" -j"$(nproc)"
+fi
+echo "build.sh: built $build${*:+ ($*)}"

@@ -1,10 +1,10 @@
 #!/usr/bin/env bash
-# Installs what is missing, builds Lumar (Release) and composites the figurine into the
+# Installs what is missing, builds the lumar command (Release) and composites the figurine into the
 # bundled sample recording. Writes out/demo.mp4, out/demo-contact.png and out/demo-frames/*.png.
 set -euo pipefail
 top=$(cd "$(dirname "$0")/.." && pwd)
 bash "$top/scripts/install-deps.sh"
-bash "$top/scripts/build.sh" release
+bash "$top/scripts/build.sh" release lumar  # the command alone: no tests or benchmarks
 lumar="$top/build/release/app/lumar"
 mkdir -p "$top/out"
 rm -rf "$top/out/demo.mp4" "$top/out/demo-frames" "$top/out/demo-contact.png"

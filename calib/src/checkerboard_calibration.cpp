@@ -13,6 +13,25 @@ namespace {
 
 std::string size_text(cv::Size s) { return std::to_string(s.width) + "x" + std::to_string(s.height); }
 
+// A board given too small (--board 8x6 on a 9x6 board) is still found, as a part of the
+// real one, and calibrates wrongly without a word. So a few views are searched again
+// for a board one corner wider or taller: if most of them hold one, the size is wrong.
+void check_not_part_of_a_larger_board(const std::vector<cv::Mat>& greys, const std::vector<std::string>& names,
+                                      cv::Size inner_corners) {
+  for (const cv::Size larger : {cv::Size(inner_corners.width + 1, inner_corners.height),
+                                cv::Size(inner_corners.width, inner_corners.height + 1)}) {
+    int found = 0;
+    std::vector<cv::Point2f> corners;
+    for (const cv::Mat& grey : greys)
+      found += cv::findChessboardCorners(
+          grey, larger, corners, cv::CALIB_CB_ADAPTIVE_THRESH | cv::CALIB_CB_NORMALIZE_IMAGE | cv::CALIB_CB_FAST_CHECK);
+    if (found * 2 > int(greys.size()))
+      throw InputError("--board " + size_text(inner_corners) + ": " + std::to_string(found) + " of " +
+                       std::to_string(greys.size()) + " views checked (" + names.front() + ", ...) show a board of " +
+                       size_text(larger) + " or more inner corners; give the whole board's inner corners");
+  }
+}
+
 }  // namespace
 
 std::vector<cv::Point3f> checkerboard_points(cv::Size inner_corners, double square_size_m) {
@@ -33,6 +52,8 @@ BoardViews detect_checkerboard_views(const std::vector<NamedImage>& images, cv::
     throw InputError("checkerboard calibration: square size must be a positive length in metres");
   const std::vector<cv::Point3f> board = checkerboard_points(inner_corners, square_size_m);
   BoardViews result;
+  std::vector<cv::Mat> checked;  // the first views with a board, to check its size on
+  std::vector<std::string> checked_names;
   result.image_size = images.front().image.size();
   for (const auto& named : images) {
     if (named.image.size() != result.image_size)
@@ -63,9 +84,11 @@ BoardViews detect_checkerboard_views(const std::vector<NamedImage>& images, cv::
     result.corners.push_back(std::move(corners));
     result.objects.push_back(board);
     result.names.push_back(named.name);
+    if (checked.size() < 3) checked.push_back(grey), checked_names.push_back(named.name);
   }
   require_board_views(result, images.size(),
                       size_text(inner_corners) + " inner-corner board (inner corners, not squares)");
+  check_not_part_of_a_larger_board(checked, checked_names, inner_corners);
   return result;
 }
 

@@ -191,6 +191,22 @@ RobustCalibrationResult calibrate_robust(const BoardViews& views, const RobustCa
                   result.orientations, o.min_orientations, o.orientation_separation_deg);
     result.warnings.emplace_back(line);
   }
+  // A distortion term within two standard deviations of zero is not measured by these
+  // views: the fit spent a degree of freedom on noise (and k2 and k3 trade off against
+  // each other, so each can look large while neither is known).
+  const auto& d = result.camera.intrinsics.distortion;
+  const struct {
+    const char* name;
+    double value, sigma;
+    const char* hint;
+  } terms[] = {{"k2", d[1], result.std_dev[5], "more views near the image corners pin it down"},
+               {"k3", d[4], result.std_dev[8], "fix it with --fix-k3 unless the lens is wide-angle"}};
+  for (const auto& t : terms)
+    if (t.sigma > 0 && std::abs(t.value) < 2 * t.sigma) {
+      std::snprintf(line, sizeof line, "%s = %.4f ± %.4f is not significant (|%s| < 2 sigma); %s", t.name, t.value,
+                    t.sigma, t.name, t.hint);
+      result.warnings.emplace_back(line);
+    }
   return result;
 }
 

@@ -54,6 +54,43 @@ case_character_classes_in_patterns() {
     "$LUMAR" calibrate --images "$BOARDS/left[2-9][0-9].jpg" --out "$TMP/none.yml"
 }
 
+case_glob_errors_are_one_line() {
+  # A pattern that matches nothing, or names a folder that is not there: one line, status 2
+  # (OpenCV's glob used to end in its own exception and status 1).
+  expect_bad_input "no file matches" "$TMP/cam.yml" -- \
+    "$LUMAR" calibrate --images "$BOARDS/nothing-*.jpg" --out "$TMP/cam.yml"
+  expect_bad_input "$TMP/missing" "$TMP/cam.yml" -- "$LUMAR" calibrate --images "$TMP/missing/*.jpg" --out "$TMP/cam.yml"
+  expect_bad_input "$TMP/missing" "$TMP/cam.yml" -- \
+    "$LUMAR" calibrate --source "images:$TMP/missing/*.jpg" --out "$TMP/cam.yml"
+}
+
+case_board_smaller_than_the_real_one() {
+  # 8x6 inner corners on the 9x6 board is found as a part of it and used to calibrate
+  # wrongly (11 views, RMS 0.169): the views show the larger board.
+  expect_bad_input "9x6" "$TMP/cam.yml" -- "$LUMAR" calibrate --images "$BOARDS/*.jpg" --board 8x6 --out "$TMP/cam.yml"
+}
+
+case_insignificant_distortion_terms_are_named() {
+  "$LUMAR" calibrate --images "$BOARDS/*.jpg" --out "$TMP/cam.yml" --json >"$TMP/out.json" 2>"$TMP/stderr" ||
+    { cat "$TMP/stderr" >&2; fail "calibrate failed"; }
+  json_check "any(w.startswith('k3 = ') and 'not significant' in w and '--fix-k3' in w for w in j['warnings'])"
+  json_check "any(w.startswith('k2 = ') and 'not significant' in w for w in j['warnings'])"
+  grep -q "warning: k3 = " "$TMP/stderr" || fail "the k3 warning is not on stderr"
+  "$LUMAR" calibrate --images "$BOARDS/*.jpg" --out "$TMP/fixed.yml" --json --fix-k3 >"$TMP/out.json" 2>/dev/null ||
+    fail "calibrate --fix-k3 failed"
+  json_check "not any(w.startswith('k3 = ') for w in j['warnings'])"
+  python3 -c "import json; print('ok:', json.load(open('$TMP/out.json'))['warnings'])"
+}
+
+case_coverage_legend_and_undistorted_preview() {
+  "$LUMAR" calibrate --images "$BOARDS/left0[1-6].jpg" --out "$TMP/cam.yml" --coverage "$TMP/coverage.png" \
+    --preview "$TMP/preview.png" >"$TMP/stdout" 2>"$TMP/stderr" || { cat "$TMP/stderr" >&2; fail "calibrate failed"; }
+  # The sensor plus a legend strip; the preview is the view as recorded beside it undistorted.
+  [ "$(png_size "$TMP/coverage.png")" = "640 554" ] || fail "coverage image is $(png_size "$TMP/coverage.png")"
+  [ "$(png_size "$TMP/preview.png")" = "1280 480" ] || fail "preview is $(png_size "$TMP/preview.png")"
+  no_temporaries "$TMP"
+}
+
 case_wrong_board_size() {
   expect_bad_input "no 7x5" "$TMP/cam.yml" -- \
     "$LUMAR" calibrate --images "$BOARDS/left0*.jpg" --board 7x5 --out "$TMP/cam.yml"

@@ -33,6 +33,57 @@ case_sweep_then_envmap() {
   awk -v u="$used" 'BEGIN { exit !(u <= 0.15) }' || fail "refined rotations are $used deg RMS off, expected <= 0.15"
 }
 
+case_not_a_sweep_is_refused() {
+  # The sample orbit is no sweep: its frames see about a tenth of the sphere, and hole
+  # filling would invent the rest. Refused below --min-coverage (25 %): exit 2, one error
+  # line after the progress lines, no map; with it lowered the map is written, with a warning.
+  local status=0
+  "$LUMAR" envmap --recording "$SRC/recordings/orbit" --out "$TMP/map.exr" --width 256 --no-refine \
+    >"$TMP/stdout" 2>"$TMP/log" || status=$?
+  [ "$status" -eq 2 ] || { cat "$TMP/log"; fail "exit status $status, expected 2"; }
+  [ "$(grep -vc '^stitching' "$TMP/log")" -eq 1 ] || { cat "$TMP/log"; fail "expected one line besides progress"; }
+  grep -q "saw only 14.6 % of the sphere, less than the 25 % --min-coverage" "$TMP/log" || { cat "$TMP/log"; fail "not refused"; }
+  [ ! -e "$TMP/map.exr" ] || fail "a map was written"
+  no_temporaries "$TMP"
+  "$LUMAR" envmap --recording "$SRC/recordings/orbit" --out "$TMP/map.exr" --width 256 --no-refine --min-coverage 0 \
+    >"$TMP/log" 2>&1 || { cat "$TMP/log"; fail "envmap --min-coverage 0 failed"; }
+  grep -q "is filled in, not measured" "$TMP/log" || { cat "$TMP/log"; fail "no warning"; }
+  is_exr "$TMP/map.exr" || fail "no map written"
+}
+
+# stitch_sweep_of MAP FRAMES EXPOSURES: a sweep of a shared map at those exposures,
+# stitched 512 wide without refinement; envmap's output in $TMP/log.
+stitch_sweep_of() {
+  rm -rf "$TMP/rec"
+  "$LUMAR" synth --sweep --envmap "$SHARED/data/envmaps/$1" --camera "$CAM" --out "$TMP/rec" --frames "$2" \
+    --exposures "$3" --supersample 1 --codec ffv1 >"$TMP/synth.log" 2>&1 || { cat "$TMP/synth.log"; fail "synth failed"; }
+  "$LUMAR" envmap --recording "$TMP/rec" --out "$TMP/map.exr" --width 512 --no-refine >"$TMP/log" 2>&1 \
+    || { cat "$TMP/log"; fail "envmap failed"; }
+}
+
+case_clipped_sun_is_named() {
+  # The shared city map's sun (peak 31,749) clips in every frame of the default exposures
+  # 0, -5, -10: the stitched map loses 11 % of its power. Warned, with the exposure to
+  # add; with -14 the sun holds and nothing is said.
+  stitch_sweep_of city.exr 90 0,-5,-10
+  grep -q "1 source(s) clipped in every frame" "$TMP/log" || { cat "$TMP/log"; fail "no clipping warning"; }
+  grep -q "next 12.0 stops under the longest" "$TMP/log" || { cat "$TMP/log"; fail "no exposure named"; }
+  grep -q "clipped source at azimuth -14[0-9]" "$TMP/log" || { cat "$TMP/log"; fail "the sun's direction is wrong"; }
+  stitch_sweep_of city.exr 120 0,-5,-10,-14
+  ! grep -q "clipped" "$TMP/log" || { cat "$TMP/log"; fail "warned although -14 holds the sun"; }
+}
+
+case_dark_regions_are_named() {
+  # The studio map is mostly dark: at the default exposures its darkest half stays within
+  # 16 codes of black, where the sensor's noise, clipped at black, biased it 40 % up.
+  # Warned, with the remedy; an exposure 4 stops longer removes both bias and warning.
+  stitch_sweep_of studio.exr 90 0,-5,-10
+  grep -q "below code 16 in every frame.*add an exposure 4 stops longer" "$TMP/log" \
+    || { cat "$TMP/log"; fail "no warning about dark regions"; }
+  stitch_sweep_of studio.exr 120 4,0,-5,-10
+  ! grep -q "below code 16" "$TMP/log" || { cat "$TMP/log"; fail "warned although +4 lifts the dark regions"; }
+}
+
 case_envmap_no_frames() {
   small_sweep "$TMP/rec"
   head -1 "$TMP/rec/frames.csv" >"$TMP/frames" && mv "$TMP/frames" "$TMP/rec/frames.csv"
@@ -293,7 +344,7 @@ case_live_tracker_two_stations() {
     cp "$TMP/img/frame-00000$i.png" "$TMP/four/"
     echo "frame-00000$i.png,$(awk -F, -v k="$i" '$1 == k { print $6 "," $7 "," $8 "," $9 }' "$TMP/rec/truth.csv"),$(sed -n "$((i + 2))p" "$TMP/img/poses.csv" | cut -d, -f9)" >>"$TMP/four.csv"
   done
-  "$LUMAR" envmap --images "$TMP/four" --poses "$TMP/four.csv" --camera "$CAM" $(vignetting_of "$TMP/rec") --no-refine \
+  "$LUMAR" envmap --images "$TMP/four" --poses "$TMP/four.csv" --camera "$CAM" $(vignetting_of "$TMP/rec") --no-refine --min-coverage 0 \
     --reference "$MAP" --out "$TMP/four.exr" --width 256 >"$TMP/four.log" 2>&1 || { cat "$TMP/four.log"; fail "--images failed"; }
   local expected
   expected=$(reported_error "$TMP/four.log")

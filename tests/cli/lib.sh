@@ -47,6 +47,11 @@ no_temporaries() {
   [ -z "$left" ] || fail "temporary files left behind: $left"
 }
 
+# png_size FILE: "WIDTH HEIGHT" of a PNG (from its header).
+png_size() {
+  python3 -c "import struct,sys; d=open(sys.argv[1],'rb').read(24); assert d[:8]==b'\x89PNG\r\n\x1a\n'; print(*struct.unpack('>II', d[16:24]))" "$1"
+}
+
 # wait_for SECONDS COMMAND...: true once COMMAND succeeds, false at the deadline.
 wait_for() {
   local deadline=$((SECONDS + $1))

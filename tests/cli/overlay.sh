@@ -119,6 +119,61 @@ case_live_headless_with_the_sessions_radiometry_and_a_filter() {
   expect_bad_input "--rig" "" -- "$LUMAR" overlay --recording "$REC" --rig "$REC/session.json" --frames-dir "$TMP/f"
 }
 
+case_progress_on_a_terminal() {
+  # On a terminal the overlay shows how far it has come (frames, rate, time left); in a
+  # log it stays quiet. `script` gives the command a pseudo-terminal.
+  script -qec "'$LUMAR' overlay --recording '$REC' --max-frames 12 --frames-dir '$TMP/frames'" "$TMP/typescript" \
+    >/dev/null 2>&1 || { cat "$TMP/typescript"; fail "overlay on a terminal failed"; }
+  grep -q "overlay \[.*\] 12/12 frames, [0-9.]* frames/s" "$TMP/typescript" || { cat "$TMP/typescript"; fail "no progress"; }
+  "$LUMAR" overlay --recording "$REC" --max-frames 3 --frames-dir "$TMP/quiet" >"$TMP/log" 2>&1 || fail "overlay failed"
+  ! grep -q "frames/s, " "$TMP/log" || fail "progress written to a log"
+}
+
+case_live_without_a_display_says_how_to_run_headless() {
+  start_emulator --rate 60
+  "$LUMAR" overlay --source "video:$SHARED/data/video/vtest.avi" --tracker "serial:$TMP/tty" \
+    --scene "$SRC/data/scenes/room/scene.json" --max-frames 2 >"$TMP/out" 2>"$TMP/err"
+  status=$?
+  [ $status -eq 1 ] || { cat "$TMP/err"; fail "exit status $status, expected 1"; }
+  [ "$(grep -c . "$TMP/err")" -eq 1 ] || { cat "$TMP/err"; fail "expected one error line"; }
+  grep -q -- "--frames-dir" "$TMP/err" || { cat "$TMP/err"; fail "the message does not say how to run headless"; }
+  # And headless it runs, live.
+  "$LUMAR" overlay --source "video:$SHARED/data/video/vtest.avi" --tracker "serial:$TMP/tty" \
+    --scene "$SRC/data/scenes/room/scene.json" --max-frames 4 --frames-dir "$TMP/frames" >"$TMP/log" 2>&1 ||
+    { cat "$TMP/log"; fail "headless live overlay failed"; }
+  [ "$(ls "$TMP/frames" | wc -l)" -eq 4 ] || fail "expected 4 frames"
+}
+
+case_irradiance_cache_said_once_and_skippable() {
+  export XDG_CACHE_HOME="$TMP/cache"
+  "$LUMAR" overlay --recording "$REC" --max-frames 1 --frames-dir "$TMP/f1" >"$TMP/log1" 2>&1 || fail "overlay failed"
+  grep -q "cached as $TMP/cache/lumar/irradiance-" "$TMP/log1" || { cat "$TMP/log1"; fail "the cache was not named"; }
+  [ "$(ls "$TMP/cache/lumar" | wc -l)" -eq 1 ] || fail "no volume in \$XDG_CACHE_HOME/lumar"
+  "$LUMAR" overlay --recording "$REC" --max-frames 1 --frames-dir "$TMP/f2" >"$TMP/log2" 2>&1 || fail "overlay failed"
+  ! grep -q "cached as" "$TMP/log2" || fail "the cache was announced again"
+  export XDG_CACHE_HOME="$TMP/other"
+  "$LUMAR" overlay --recording "$REC" --max-frames 1 --frames-dir "$TMP/f3" --no-cache >"$TMP/log3" 2>&1 ||
+    fail "overlay --no-cache failed"
+  [ ! -e "$TMP/other/lumar" ] || fail "--no-cache wrote the cache"
+  cmp -s "$TMP/f1/frame-000000.png" "$TMP/f3/frame-000000.png" || fail "a rebuilt volume gave another frame"
+}
+
+case_regress_hints_and_options() {
+  copy_recording
+  rm "$TMP/recordings/orbit/expected.json"
+  expect_bad_input "lumar regress --update" "" -- "$LUMAR" regress "$TMP/recordings/orbit"
+  # --update says the thresholds it sets, and how they follow from what it measured.
+  "$LUMAR" regress --update "$TMP/recordings/orbit" >"$TMP/log" 2>&1 || { cat "$TMP/log"; fail "regress --update failed"; }
+  grep -q "thresholds for .*tracked-pose error mean <= 1.25 x [0-9.]* + 0.5 = [0-9.]* px" "$TMP/log" ||
+    { cat "$TMP/log"; fail "the thresholds were not explained"; }
+  # --scene for a recording whose session names none (a live recording).
+  python3 -c "import json; p='$TMP/recordings/orbit/session.json'; j=json.load(open(p)); j['scene']=''; json.dump(j, open(p, 'w'))"
+  expect_bad_input "--scene" "" -- "$LUMAR" regress "$TMP/recordings/orbit"
+  "$LUMAR" regress "$TMP/recordings/orbit" --scene "$SRC/data/scenes/room/scene.json" >"$TMP/log" 2>&1 ||
+    { cat "$TMP/log"; fail "regress --scene failed"; }
+  grep -q "^PASS" "$TMP/log" || fail "no PASS line"
+}
+
 case_help_describes_every_option() {
   "$LUMAR" --help >"$TMP/h" || fail "lumar --help failed"
   for cmd in synth overlay regress calibrate; do

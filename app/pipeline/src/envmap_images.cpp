@@ -14,6 +14,7 @@
 #include "lumar/calib/camera_file.h"
 #include "lumar/calib/camera_response.h"
 #include "lumar/capture/image_sequence_source.h"
+#include "lumar/pipeline/progress.h"
 
 namespace lumar::pipeline {
 

@@ -2,6 +2,7 @@
 
 #include <unistd.h>
 
+#include <fmt/format.h>
 #include <spdlog/spdlog.h>
 #include <algorithm>
 #include <chrono>
@@ -10,33 +11,21 @@
 #include <sstream>
 
 #include "lumar/base/error.h"
+#include "lumar/base/latlong.h"
 #include "lumar/base/output_file.h"
 #include "lumar/base/pose.h"
 #include "lumar/calib/image_file.h"
+#include "lumar/envmap/clipped_sources.h"
 #include "lumar/envmap/envmap_quality.h"
 #include "lumar/envmap/hole_filling.h"
 #include "lumar/envmap/orientation_refinement.h"
+#include "lumar/pipeline/progress.h"
 
 namespace lumar::pipeline {
 
 void check_map_width(int width) {
   if (width <= 0 || width % 2 != 0 || width > 16384)
     throw InputError("--width " + std::to_string(width) + ": expected an even number of pixels up to 16384");
-}
-
-Progress::Progress(std::string what, int total) : what_(std::move(what)), total_(std::max(1, total)), tty_(isatty(2)) {}
-
-void Progress::update(int done) {
-  const int tenth = done * 10 / total_;
-  if (tty_) {
-    const int filled = std::clamp(done * 30 / total_, 0, 30);
-    std::fprintf(stderr, "\r%s [%s%s] %d/%d", what_.c_str(), std::string(filled, '#').c_str(),
-                 std::string(30 - filled, ' ').c_str(), done, total_);
-    if (done == total_) std::fprintf(stderr, "\n");
-  } else if (tenth != last_tenth_) {
-    std::fprintf(stderr, "%s: %d/%d\n", what_.c_str(), done, total_);
-  }
-  last_tenth_ = tenth;
 }
 
 std::optional<double> compare_with_reference(const EnvironmentMap& map, const cv::Mat& coverage,
@@ -80,6 +69,46 @@ void write_corrections(const SweepInput& in, const calib::RefinementResult& resu
 }
 
 }  // namespace
+
+void warn_about_exposure_range(const calib::EnvmapStitcher& stitcher, const std::vector<double>& exposures) {
+  // Too dark: regions no exposure lifted clear of the sensor's noise.
+  const cv::Mat dark = stitcher.near_black(), coverage = stitcher.coverage();
+  double dark_sr = 0, covered_sr = 0;
+  for (int r = 0; r < dark.rows; ++r) {
+    const double omega = latlong_pixel_solid_angle(r, dark.cols, dark.rows);
+    for (int c = 0; c < dark.cols; ++c) {
+      if (coverage.at<std::uint16_t>(r, c) > 0) covered_sr += omega;
+      if (dark.at<uchar>(r, c)) dark_sr += omega;
+    }
+  }
+  if (covered_sr > 0 && dark_sr > kNearBlackShareWarned * covered_sr)
+    spdlog::warn(
+        "envmap: {:.1f} % of what the frames saw was below code {:.0f} in every frame, the longest exposure too, "
+        "where the sensor's noise, clipped at black, makes it up to 40 % too bright; add an exposure 4 stops longer "
+        "than "
+        "the longest",
+        100 * dark_sr / covered_sr, calib::EnvmapStitcher::kNearBlackCode);
+  const cv::Mat clipped = stitcher.clipped();
+  const EnvironmentMap map = stitcher.current_map();
+  const auto sources = calib::find_clipped_sources(map, clipped);
+  if (sources.empty() || exposures.empty()) return;
+  const auto [shortest, longest] = std::minmax_element(exposures.begin(), exposures.end());
+  const double under = std::log2(*longest / *shortest);
+  // Only a lower bound is known, so the exposure that holds them is found by trying:
+  // two stops further down at a time.
+  spdlog::warn(
+      "envmap: {} source(s) clipped in every frame, the shortest exposure ({:.1f} stops under the longest) too; the "
+      "map holds only a lower bound there ({:.2f} % of its power as recorded), so their light and hard shadows are "
+      "too weak. Add shorter exposures until they hold: next {:.1f} stops under the longest",
+      sources.size(), under, 100 * calib::clipped_power_share(map, clipped), under + 2.0);
+  for (std::size_t i = 0; i < sources.size() && i < 3; ++i) {
+    const auto& s = sources[i];
+    spdlog::warn(
+        "envmap:   clipped source at azimuth {:.1f} deg, elevation {:.1f} deg: {} pixels, {:.2g} sr, "
+        "luminance at least {:.4g}",
+        s.azimuth_deg, s.elevation_deg, s.pixels, s.solid_angle, s.recorded_peak);
+  }
+}
 
 void stitch_sweep(const SweepInput& in, const EnvmapOutputOptions& o) {
   const int n = int(in.rotations.size());
@@ -132,6 +161,15 @@ void stitch_sweep(const SweepInput& in, const EnvmapOutputOptions& o) {
   const auto t0 = std::chrono::steady_clock::now();
   read_all("stitching", [&](const cv::Mat& image, int k) { stitcher.add_frame(image, rotations[k], in.exposures[k]); });
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  const double sphere = calib::sphere_coverage(stitcher.coverage());
+  if (sphere < o.min_coverage)
+    throw InputError(in.name + ": the frames saw only " + fmt::format("{:.1f}", 100 * sphere) +
+                     " % of the sphere, less than the " + fmt::format("{:.0f}", 100 * o.min_coverage) +
+                     " % --min-coverage asks; hole filling would invent the rest: sweep the camera all around");
+  if (sphere < kWellCoveredSphere)
+    spdlog::warn("envmap: the frames saw {:.1f} % of the sphere; the other {:.1f} % is filled in, not measured",
+                 100 * sphere, 100 * (1 - sphere));
+  warn_about_exposure_range(stitcher, in.exposures);
   int filled = 0;
   const double covered = write_envmap_outputs(stitcher.current_map(), stitcher.coverage(), o, &filled);
   spdlog::info("envmap: wrote {} ({}x{}, {:.1f} % covered, {} pixels filled; {} frames in {:.2f} s incl. decoding)",

@@ -3,6 +3,9 @@
 #include <fmt/format.h>
 
 #include <chrono>
+#include <cstdlib>
+
+#include "lumar/base/error.h"
 
 namespace lumar::pipeline {
 
@@ -29,6 +32,11 @@ Overlay::Overlay(std::shared_ptr<const LoadedScene> scene, const CameraIntrinsic
                  const OverlaySettings& settings)
     : exposure_(radiometry.exposure) {
   if (settings.window) {
+    const char* display = std::getenv("DISPLAY");
+    if (!display || !*display)
+      throw RuntimeError(
+          "overlay: no display to open a window on (DISPLAY is not set); to run headless, leave out --window and "
+          "give --out or --frames-dir (the live path too), or run under xvfb-run");
     auto w = std::make_unique<gl::WindowContext>(camera.width, camera.height, settings.window_title);
     window_ = w.get();
     context_ = std::move(w);
@@ -36,7 +44,8 @@ Overlay::Overlay(std::shared_ptr<const LoadedScene> scene, const CameraIntrinsic
     context_ = gl::create_headless_context();
   }
   const calib::UndistortionMaps maps = calib::make_undistortion_maps(camera, settings.undistortion);
-  compositor_ = std::make_unique<Compositor>(std::move(scene), maps.output, maps.map_x, maps.map_y);
+  compositor_ =
+      std::make_unique<Compositor>(std::move(scene), maps.output, maps.map_x, maps.map_y, settings.volume_cache);
   compositor_->renderer().set_video_radiometry(video_radiometry(radiometry, camera, response));
   if (settings.adapt_lighting_every > 0)
     live_lighting_.emplace(camera, maps, response.value_or(calib::srgb_response(1.0)), radiometry,

@@ -80,4 +80,14 @@ std::vector<glm::dvec3> fibonacci_directions(int count) {
   return out;
 }
 
+double sphere_coverage(const cv::Mat& coverage_count) {
+  if (coverage_count.empty()) return 0.0;
+  double seen = 0;
+  for (int r = 0; r < coverage_count.rows; ++r) {
+    const double w = latlong_pixel_solid_angle(r, coverage_count.cols, coverage_count.rows);
+    seen += w * cv::countNonZero(coverage_count.row(r));
+  }
+  return seen / (4.0 * kPi);
+}
+
 }  // namespace lumar::calib

@@ -57,6 +57,7 @@ EnvmapStitcher::EnvmapStitcher(const StitchSettings& settings) : settings_(setti
   }
   accum_.assign(n * 4, 0.f);
   count_.assign(n, 0);
+  peak_code_.assign(n, 0.f);
   fallback_.assign(n * 3, 0.f);
   fallback_kind_.assign(n, 0);
   for (int ch = 0; ch < 3; ++ch)
@@ -79,7 +80,7 @@ void EnvmapStitcher::prepare_levels(const cv::Mat& image, double exposure) {
   Level& l0 = levels_[0];
   l0.width = cam.width, l0.height = cam.height;
   const std::size_t n = std::size_t(cam.width) * cam.height;
-  l0.rgb.resize(n * 3), l0.weight.resize(n), l0.clipped.resize(n);
+  l0.rgb.resize(n * 3), l0.weight.resize(n), l0.code.resize(n), l0.clipped.resize(n);
   const double inv_hd2 = 4.0 / (double(cam.width) * cam.width + double(cam.height) * cam.height);
   const float va = float(settings_.vignetting_a), vb = float(settings_.vignetting_b);
   const int sat = settings_.saturated_value, dark = settings_.dark_value;
@@ -94,6 +95,7 @@ void EnvmapStitcher::prepare_levels(const cv::Mat& image, double exposure) {
                  l0.rgb[i * 3 + 2] = lut_[0][p[0]] * scale;
       const int vmax = std::max({p[0], p[1], p[2]});
       l0.clipped[i] = vmax >= sat;
+      l0.code[i] = float(vmax);
       // Ramps up from the dark level (8-bit steps are coarse there), down towards clipping.
       l0.weight[i] = (vmax >= sat || vmax <= dark)
                          ? 0.f
@@ -106,11 +108,11 @@ void EnvmapStitcher::prepare_levels(const cv::Mat& image, double exposure) {
     Level& c = levels_[k];
     c.width = std::max(1, f.width / 2), c.height = std::max(1, f.height / 2);
     const std::size_t m = std::size_t(c.width) * c.height;
-    c.rgb.resize(m * 3), c.weight.resize(m), c.clipped.resize(m);
+    c.rgb.resize(m * 3), c.weight.resize(m), c.code.resize(m), c.clipped.resize(m);
     tbb::parallel_for(0, c.height, [&](int y) {
       for (int x = 0; x < c.width; ++x) {
         const std::size_t o = std::size_t(y) * c.width + x;
-        float sum[3] = {0, 0, 0}, w = 0;
+        float sum[3] = {0, 0, 0}, w = 0, code = 0;
         std::uint8_t clip = 0;
         for (int dy = 0; dy < 2; ++dy)
           for (int dx = 0; dx < 2; ++dx) {
@@ -118,10 +120,12 @@ void EnvmapStitcher::prepare_levels(const cv::Mat& image, double exposure) {
                 std::size_t(std::min(2 * y + dy, f.height - 1)) * f.width + std::min(2 * x + dx, f.width - 1);
             sum[0] += f.rgb[i * 3], sum[1] += f.rgb[i * 3 + 1], sum[2] += f.rgb[i * 3 + 2];
             w += f.weight[i];
+            code += f.code[i];
             clip |= f.clipped[i];
           }
         c.rgb[o * 3] = 0.25f * sum[0], c.rgb[o * 3 + 1] = 0.25f * sum[1], c.rgb[o * 3 + 2] = 0.25f * sum[2];
         c.weight[o] = 0.25f * w;
+        c.code[o] = 0.25f * code;
         c.clipped[o] = clip;
       }
     });
@@ -209,14 +213,16 @@ void EnvmapStitcher::add_frame(const cv::Mat& image, const glm::dquat& R_world_c
       const std::size_t taps[4] = {std::size_t(v0) * lw + u0, std::size_t(v0) * lw + u1, std::size_t(v1) * lw + u0,
                                    std::size_t(v1) * lw + u1};
       const float tw[4] = {(1 - fu) * (1 - fv), fu * (1 - fv), (1 - fu) * fv, fu * fv};
-      float rgb[3] = {0, 0, 0}, w_value = 0;
+      float rgb[3] = {0, 0, 0}, w_value = 0, code = 0;
       bool clipped = false;
       for (int t = 0; t < 4; ++t) {
         const float* c = &level.rgb[taps[t] * 3];
         rgb[0] += tw[t] * c[0], rgb[1] += tw[t] * c[1], rgb[2] += tw[t] * c[2];
         w_value += tw[t] * level.weight[taps[t]];
+        code += tw[t] * level.code[taps[t]];
         clipped |= level.clipped[taps[t]] != 0;
       }
+      if (!clipped) peak_code_[idx] = std::max(peak_code_[idx], code);
       const float du = u - cx, dv = v - cy;
       const float rr = (du * du + dv * dv) * inv_hd2;
       if (count_[idx] < 65535) ++count_[idx];
@@ -270,6 +276,20 @@ cv::Mat EnvmapStitcher::weights() const {
 cv::Mat EnvmapStitcher::coverage() const {
   cv::Mat m(height_, width_, CV_16UC1);
   std::copy(count_.begin(), count_.end(), m.ptr<std::uint16_t>(0));
+  return m;
+}
+
+cv::Mat EnvmapStitcher::clipped() const {
+  cv::Mat m(height_, width_, CV_8UC1);
+  for (std::size_t i = 0; i < count_.size(); ++i)
+    m.data[i] = (accum_[i * 4 + 3] <= 0.f && fallback_kind_[i] == 2) ? 255 : 0;
+  return m;
+}
+
+cv::Mat EnvmapStitcher::near_black() const {
+  cv::Mat m(height_, width_, CV_8UC1);
+  for (std::size_t i = 0; i < count_.size(); ++i)
+    m.data[i] = (accum_[i * 4 + 3] > 0.f && peak_code_[i] < kNearBlackCode) ? 255 : 0;
   return m;
 }
 

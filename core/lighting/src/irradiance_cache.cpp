@@ -14,7 +14,9 @@ namespace lumar {
 
 namespace {
 
-constexpr char kMagic[8] = {'L', 'U', 'M', 'A', 'R', 'I', 'V', '2'};
+// Version 3: probes inside geometry are found with back faces winning ties between
+// coincident faces (RayScene::intersect), so volumes built before may differ.
+constexpr char kMagic[8] = {'L', 'U', 'M', 'A', 'R', 'I', 'V', '3'};
 
 struct Writer {
   std::ofstream out;
@@ -185,6 +187,11 @@ IrradianceVolume cached_irradiance_volume(const RoomRadiance& radiance, const gl
   try {
     std::filesystem::create_directories(cache_dir);
     v.save(file);
+    // Said once, when the file is made: later runs load it without a word.
+    spdlog::info(
+        "irradiance volume built in {:.1f} s and cached as {} (later runs load it; XDG_CACHE_HOME moves the "
+        "cache, --no-cache skips it)",
+        v.stats().build_ms * 1e-3, file.string());
   } catch (const std::exception& e) {
     spdlog::warn("irradiance cache {}: {} (continuing without caching)", cache_dir.string(), e.what());
   }

@@ -11,7 +11,7 @@
 namespace lumar {
 
 Compositor::Compositor(std::shared_ptr<const LoadedScene> scene, const CameraIntrinsics& output_camera,
-                       const cv::Mat& map_x, const cv::Mat& map_y)
+                       const cv::Mat& map_x, const cv::Mat& map_y, bool volume_cache)
     : camera_(output_camera.without_distortion()), scene_(std::move(scene)) {
   const LoadedScene& s = *scene_;
   sh_ = project_radiance_sh9(s.map);
@@ -20,7 +20,7 @@ Compositor::Compositor(std::shared_ptr<const LoadedScene> scene, const CameraInt
   // Spatially varying light: the irradiance volume over the movement box (cached on disk).
   if (const std::string& method = s.manifest.lighting.method; method != "sh9") {
     bool loaded = false;
-    volume_ = std::make_shared<IrradianceVolume>(scene_irradiance_volume(s, method, true, {}, &loaded));
+    volume_ = std::make_shared<IrradianceVolume>(scene_irradiance_volume(s, method, volume_cache, {}, &loaded));
     renderer_->set_irradiance_volume(volume_.get());
     spdlog::debug("irradiance volume ({}): {} probes, {}", volume_->settings().describe(), volume_->stats().probes,
                   loaded ? "loaded from the cache" : "built");

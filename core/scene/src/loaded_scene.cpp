@@ -1,10 +1,85 @@
 #include "lumar/scene/loaded_scene.h"
 
+#include <spdlog/spdlog.h>
+
 #include <glm/gtc/matrix_transform.hpp>
+#include <optional>
+
+#include "lumar/base/error.h"
 
 #include "decode_counter.h"
 
 namespace lumar {
+
+namespace {
+
+// The highest point of the proxy straight below (x, z) and not above `from_y`, if any:
+// a ray down, tested against every triangle (a proxy room is a few hundred of them).
+std::optional<double> surface_below(const Mesh& room, double x, double z, double from_y) {
+  std::optional<double> best;
+  for (std::size_t t = 0; t + 2 < room.indices.size(); t += 3) {
+    const glm::dvec3 a(room.positions[room.indices[t]]), b(room.positions[room.indices[t + 1]]),
+        c(room.positions[room.indices[t + 2]]);
+    // Barycentric coordinates of (x, z) in the triangle's projection on the floor plane.
+    const double d = (b.z - c.z) * (a.x - c.x) + (c.x - b.x) * (a.z - c.z);
+    if (std::abs(d) < 1e-12) continue;  // a wall, seen edge-on from above
+    const double u = ((b.z - c.z) * (x - c.x) + (c.x - b.x) * (z - c.z)) / d;
+    const double v = ((c.z - a.z) * (x - c.x) + (a.x - c.x) * (z - c.z)) / d;
+    if (u < 0 || v < 0 || u + v > 1) continue;
+    const double y = u * a.y + v * b.y + (1 - u - v) * c.y;
+    if (y <= from_y + 1e-9 && (!best || y > *best)) best = y;
+  }
+  return best;
+}
+
+std::pair<glm::dvec3, glm::dvec3> posed_bounds(const Mesh& model, const glm::dmat4& T) {
+  glm::dvec3 lo(1e300), hi(-1e300);
+  for (const glm::vec3& p : model.positions) {
+    const glm::dvec3 w(T * glm::dvec4(glm::dvec3(p), 1.0));
+    lo = glm::min(lo, w), hi = glm::max(hi, w);
+  }
+  return {lo, hi};
+}
+
+bool inside(const glm::dvec3& lo, const glm::dvec3& hi, const glm::dvec3& box_lo, const glm::dvec3& box_hi,
+            double slack) {
+  for (int a = 0; a < 3; ++a)
+    if (lo[a] < box_lo[a] - slack || hi[a] > box_hi[a] + slack) return false;
+  return true;
+}
+
+// The object's final pose: a bottom-centre origin and on_floor need its mesh and the
+// proxy. Warns when it stands outside the movement box (its lighting is extrapolated
+// there) or outside the room.
+glm::dmat4 finish_pose(const Scene& manifest, std::size_t index, const SceneObject& o, const Mesh& model,
+                       const Mesh& room) {
+  glm::dmat4 T = o.T_world_model;
+  const std::string key = manifest.manifest.string() + ": objects[" + std::to_string(index) + "] (" + o.name + ")";
+  if (!o.pose.model_origin) {
+    // The middle of the bottom of the rotated, scaled model's box lands at `translation`.
+    const glm::dmat4 RS = glm::mat4_cast(o.pose.rotation) * glm::scale(glm::dmat4(1.0), glm::dvec3(o.pose.scale));
+    const auto [lo, hi] = posed_bounds(model, RS);
+    const glm::dvec3 bottom_centre(0.5 * (lo.x + hi.x), lo.y, 0.5 * (lo.z + hi.z));
+    T = glm::translate(glm::dmat4(1.0), o.pose.translation - bottom_centre) * RS;
+  }
+  if (o.pose.on_floor) {
+    const auto [lo, hi] = posed_bounds(model, T);
+    const auto y = surface_below(room, 0.5 * (lo.x + hi.x), 0.5 * (lo.z + hi.z), hi.y);
+    if (!y) throw InputError(key + ": pose.on_floor: no proxy surface below the object; move it over the floor");
+    T = glm::translate(glm::dmat4(1.0), glm::dvec3(0.0, *y - lo.y, 0.0)) * T;
+  }
+  const auto [lo, hi] = posed_bounds(model, T);
+  if (!inside(lo, hi, manifest.movement_min, manifest.movement_max, 1e-3))
+    spdlog::warn("{}: stands outside the movement box, where its lighting is extrapolated", key);
+  if (room.triangle_count() > 0) {
+    const auto [room_lo, room_hi] = room.bounds();
+    if (!inside(lo, hi, glm::dvec3(room_lo), glm::dvec3(room_hi), 1e-3))
+      spdlog::warn("{}: reaches outside the proxy room", key);
+  }
+  return T;
+}
+
+}  // namespace
 
 LoadedScene load_scene_files(const Scene& manifest) {
   LoadedScene out;
@@ -17,12 +92,14 @@ LoadedScene load_scene_files(const Scene& manifest) {
   // Objects that share a mesh file share one decode.
   std::map<std::filesystem::path, const Mesh*> decoded;
   out.objects.reserve(manifest.objects.size());  // the pointers above stay valid
-  for (const SceneObject& o : manifest.objects) {
+  for (std::size_t i = 0; i < manifest.objects.size(); ++i) {
+    const SceneObject& o = manifest.objects[i];
     LoadedObject object{o.name, {}, o.T_world_model, o.albedo};
     if (const auto it = decoded.find(o.mesh); it != decoded.end())
       object.model = *it->second;
     else
       object.model = load_mesh(o.mesh);
+    object.T_world_model = finish_pose(manifest, i, o, object.model, out.room);
     out.objects.push_back(std::move(object));
     decoded.emplace(o.mesh, &out.objects.back().model);
   }

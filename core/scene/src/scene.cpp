@@ -130,6 +130,51 @@ json parse_manifest(const std::filesystem::path& manifest) {
   }
 }
 
+// "pose": translation, one of rotation_axis + rotation_deg | yaw_pitch_roll_deg |
+// rotation_wxyz, scale, model_origin ([x, y, z] or "bottom-centre"), on_floor.
+ObjectPose read_pose(const ManifestReader& r, const json& pose, const std::string& pk) {
+  r.only_keys(pose, pk,
+              {"translation", "rotation_axis", "rotation_deg", "yaw_pitch_roll_deg", "rotation_wxyz", "scale",
+               "model_origin", "on_floor"});
+  ObjectPose p;
+  p.translation = r.vec3_or(pose, pk, "translation", p.translation);
+  const bool axis_angle = pose.contains("rotation_axis") || pose.contains("rotation_deg");
+  const int forms = int(axis_angle) + int(pose.contains("yaw_pitch_roll_deg")) + int(pose.contains("rotation_wxyz"));
+  if (forms > 1) r.fail(pk, "give one rotation: rotation_axis and rotation_deg, yaw_pitch_roll_deg, or rotation_wxyz");
+  if (axis_angle) {
+    const glm::dvec3 axis = r.vec3_or(pose, pk, "rotation_axis", glm::dvec3(0.0, 1.0, 0.0));
+    if (glm::length(axis) < 1e-9) r.fail(pk + ".rotation_axis", "must not be the zero vector");
+    p.rotation = axis_angle_deg(axis, r.number_or(pose, pk, "rotation_deg", 0.0));
+  } else if (pose.contains("yaw_pitch_roll_deg")) {
+    // Yaw about world +Y (up), then pitch about +X, then roll about +Z: R = Ry Rx Rz.
+    const glm::dvec3 a = r.vec3(pose.at("yaw_pitch_roll_deg"), pk + ".yaw_pitch_roll_deg");
+    p.rotation = axis_angle_deg({0, 1, 0}, a.x) * axis_angle_deg({1, 0, 0}, a.y) * axis_angle_deg({0, 0, 1}, a.z);
+  } else if (pose.contains("rotation_wxyz")) {
+    const json& q = pose.at("rotation_wxyz");
+    const char* what = "expected a unit quaternion [w, x, y, z]";
+    if (!q.is_array() || q.size() != 4) r.fail(pk + ".rotation_wxyz", what);
+    double c[4];
+    for (int i = 0; i < 4; ++i) c[i] = r.number(q[std::size_t(i)], pk + ".rotation_wxyz");
+    const glm::dquat rotation(c[0], c[1], c[2], c[3]);
+    if (std::abs(glm::length(rotation) - 1.0) > 1e-3) r.fail(pk + ".rotation_wxyz", what);
+    p.rotation = glm::normalize(rotation);
+  }
+  p.scale = r.number_or(pose, pk, "scale", 1.0);
+  if (!(p.scale > 0.0)) r.fail(pk + ".scale", "must be positive");
+  if (pose.contains("model_origin")) {
+    const json& origin = pose.at("model_origin");
+    if (origin.is_string()) {
+      if (origin.get<std::string>() != "bottom-centre")
+        r.fail(pk + ".model_origin", "expected [x, y, z] or \"bottom-centre\"");
+      p.model_origin = std::nullopt;
+    } else {
+      p.model_origin = r.vec3(origin, pk + ".model_origin", "expected [x, y, z] or \"bottom-centre\"");
+    }
+  }
+  p.on_floor = r.boolean_or(pose, pk, "on_floor", false);
+  return p;
+}
+
 SceneObject read_object(const ManifestReader& r, const json& v, const std::string& key) {
   if (!v.is_object()) r.fail(key, "expected an object");
   r.only_keys(v, key, {"name", "mesh", "albedo", "pose"});
@@ -144,24 +189,11 @@ SceneObject read_object(const ManifestReader& r, const json& v, const std::strin
     object.albedo = glm::vec3(a);
   }
 
-  glm::dvec3 translation(0.0), axis(0.0, 1.0, 0.0), model_origin(0.0);
-  double angle_deg = 0.0, scale = 1.0;
-  if (v.contains("pose")) {
-    const json& pose = r.object(v, key, "pose");
-    const std::string pk = key + ".pose";
-    r.only_keys(pose, pk, {"translation", "rotation_axis", "rotation_deg", "scale", "model_origin"});
-    translation = r.vec3_or(pose, pk, "translation", translation);
-    axis = r.vec3_or(pose, pk, "rotation_axis", axis);
-    angle_deg = r.number_or(pose, pk, "rotation_deg", 0.0);
-    scale = r.number_or(pose, pk, "scale", 1.0);
-    model_origin = r.vec3_or(pose, pk, "model_origin", model_origin);
-    if (glm::length(axis) < 1e-9) r.fail(pk + ".rotation_axis", "must not be the zero vector");
-    if (!(scale > 0.0)) r.fail(pk + ".scale", "must be positive");
-  }
-  const glm::dmat4 rotate = glm::mat4_cast(axis_angle_deg(axis, angle_deg));
-  object.T_world_model = glm::translate(glm::dmat4(1.0), translation) * rotate *
-                         glm::scale(glm::dmat4(1.0), glm::dvec3(scale)) *
-                         glm::translate(glm::dmat4(1.0), -model_origin);
+  if (v.contains("pose")) object.pose = read_pose(r, r.object(v, key, "pose"), key + ".pose");
+  const ObjectPose& p = object.pose;
+  object.T_world_model = glm::translate(glm::dmat4(1.0), p.translation) * glm::mat4_cast(p.rotation) *
+                         glm::scale(glm::dmat4(1.0), glm::dvec3(p.scale)) *
+                         glm::translate(glm::dmat4(1.0), -p.model_origin.value_or(glm::dvec3(0.0)));
   return object;
 }
 

@@ -21,10 +21,18 @@ namespace lumar::pipeline {
 struct EnvmapOutputOptions {
   std::string out, coverage, preview, corrections, reference;
   int width = 1024;
+  // Refuse a map whose frames saw less than this share of the sphere (hole filling
+  // would invent the rest); warn below kWellCoveredSphere.
+  double min_coverage = 0.25;
   bool no_refine = false;
   bool no_fill = false;
   std::optional<double> azimuth_offset_deg;
 };
+
+// Below this share of the sphere seen, a map is mostly invented: stitch_sweep warns.
+inline constexpr double kWellCoveredSphere = 0.6;
+// Share of the seen sphere that may stay near black before the sweep is warned.
+inline constexpr double kNearBlackShareWarned = 0.05;
 
 // Throws InputError unless the width is a positive even number up to 16384.
 void check_map_width(int width);
@@ -46,6 +54,11 @@ struct SweepInput {
   std::string default_reference;  // reference map to compare with when --reference is not given
 };
 
+// Warns when the exposures did not span the scene: regions that stayed near black in
+// every frame (their noise biases them up), and sources every frame saw clipped, the
+// shortest exposure too (calib/envmap/clipped_sources.h); names the exposure to add.
+void warn_about_exposure_range(const calib::EnvmapStitcher& stitcher, const std::vector<double>& exposures);
+
 // Refines, stitches, fills and writes every output asked for.
 void stitch_sweep(const SweepInput& input, const EnvmapOutputOptions& options);
 
@@ -60,18 +73,5 @@ double write_envmap_outputs(EnvironmentMap map, const cv::Mat& coverage, const E
 // multiple of the map's; returns it (nullopt when not compared).
 std::optional<double> compare_with_reference(const EnvironmentMap& map, const cv::Mat& coverage,
                                              const std::string& reference);
-
-// A progress bar on stderr: redrawn in place on a terminal, a line per tenth otherwise.
-class Progress {
- public:
-  Progress(std::string what, int total);
-  void update(int done);
-
- private:
-  std::string what_;
-  int total_;
-  bool tty_;
-  int last_tenth_ = -1;
-};
 
 }  // namespace lumar::pipeline

@@ -25,6 +25,7 @@ struct OverlaySettings {
   int adapt_lighting_every = 0;
   bool window = false;  // a GLFW window to draw into; else a headless EGL context
   std::string window_title = "lumar overlay";
+  bool volume_cache = true;  // the irradiance volume from / into the disk cache
 };
 
 struct StageTimes {  // milliseconds, summed over frames

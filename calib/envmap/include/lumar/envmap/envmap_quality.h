@@ -22,6 +22,10 @@ double median_relative_luminance_error(const EnvironmentMap& a, const Environmen
 // in world directions (the map's azimuth offset applied).
 glm::dvec3 irradiance_direct(const EnvironmentMap& map, const glm::dvec3& world_normal);
 
+// The share of the sphere's solid angle that a coverage count (CV_16UC1, a lat-long
+// map's size; envmap_stitcher.h) saw at least once: 0 to 1.
+double sphere_coverage(const cv::Mat& coverage_count);
+
 // `count` unit directions spread evenly over the sphere (Fibonacci lattice).
 std::vector<glm::dvec3> fibonacci_directions(int count);
 

@@ -52,6 +52,15 @@ class EnvmapStitcher {
   cv::Mat weights() const;
   // How many frames saw each map pixel (CV_16UC1, saturating).
   cv::Mat coverage() const;
+  // Pixels every frame saw clipped, the shortest exposure included (CV_8UC1, 255): the
+  // map holds only a lower bound there (current_map shows the brightest clipped sample).
+  cv::Mat clipped() const;
+  // Pixels measured only from samples within kNearBlackCode of black (CV_8UC1, 255).
+  // There the sensor's noise, which an 8-bit image clips at black, biases the mean up: a
+  // studio sweep's darkest regions came out 40 % too bright until an exposure 4 stops
+  // longer lifted them (docs/envmap.md).
+  cv::Mat near_black() const;
+  static constexpr float kNearBlackCode = 16.f;
   int frames_added() const { return frames_; }
   int width() const { return width_; }
   int height() const { return height_; }
@@ -64,6 +73,7 @@ class EnvmapStitcher {
   std::vector<float> row_theta_;   // polar angle of each row's centres
   std::vector<float> accum_;       // per pixel: weighted R, G, B, weight
   std::vector<std::uint16_t> count_;
+  std::vector<float> peak_code_;  // per pixel: the brightest unclipped sample's 8-bit code
   // Where no sample was well exposed: the brightest clipped sample (a lower bound, from
   // the shortest exposure) or else the darkest near-black one (an upper bound).
   std::vector<float> fallback_;                  // R, G, B per pixel
@@ -74,7 +84,7 @@ class EnvmapStitcher {
   // One level of the frame's box pyramid: linear RGB, trust in [0, 1], clipped flag.
   struct Level {
     int width = 0, height = 0;
-    std::vector<float> rgb, weight;
+    std::vector<float> rgb, weight, code;  // code: the brightest channel's 8-bit value
     std::vector<std::uint8_t> clipped;
   };
   void prepare_levels(const cv::Mat& image, double exposure);

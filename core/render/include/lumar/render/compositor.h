@@ -23,8 +23,10 @@ class Compositor {
   // `output_camera`: the undistorted camera the renderer draws with. `map_x`, `map_y`:
   // for each output pixel, where to sample the distorted video (may be empty when the
   // video is already undistorted).
+  // `volume_cache`: load the irradiance volume from the disk cache, and store it there
+  // once built (lighting/irradiance_volume.h); false: build it every time.
   Compositor(std::shared_ptr<const LoadedScene> scene, const CameraIntrinsics& output_camera, const cv::Mat& map_x,
-             const cv::Mat& map_y);
+             const cv::Mat& map_y, bool volume_cache = true);
 
   // Composites one BGR8 video frame seen from T_world_camera (nullopt: no pose, the
   // undistorted video alone); `exposure` is the video's linear value per unit of scene radiance.

@@ -5,16 +5,31 @@
 #include <array>
 #include <filesystem>
 #include <glm/glm.hpp>
+#include <glm/gtc/quaternion.hpp>
 #include <optional>
 #include <string>
 #include <vector>
 
 namespace lumar {
 
+// Where an object stands (manifest key "pose", docs/formats.md). The rotation is given
+// as an axis and an angle, as yaw, pitch and roll, or as a quaternion.
+struct ObjectPose {
+  glm::dvec3 translation{0.0};
+  glm::dquat rotation{1.0, 0.0, 0.0, 0.0};
+  double scale = 1.0;
+  // The model point that lands at `translation`; nullopt: "bottom-centre", the middle of
+  // the bottom of the rotated, scaled model's bounding box (known once the mesh is read).
+  std::optional<glm::dvec3> model_origin = glm::dvec3(0.0);
+  bool on_floor = false;  // moved up or down until its lowest point rests on the proxy below it
+};
+
 struct SceneObject {
   std::string name;
   std::filesystem::path mesh;
-  // T_world_model = translate(translation) * rotate(axis, angle) * scale(s) * translate(-model_origin)
+  ObjectPose pose;
+  // translate(translation) * R * scale * translate(-model_origin), as given: load_scene_files
+  // (loaded_scene.h) finishes a bottom-centre origin and on_floor, which need the mesh.
   glm::dmat4 T_world_model{1.0};
   glm::vec3 albedo{0.8f};
 };

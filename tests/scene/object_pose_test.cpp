@@ -1,0 +1,106 @@
+// Object poses in a manifest: the three forms of rotation agree with each other,
+// "bottom-centre" puts the bottom of the rotated model's box at the translation, and
+// "on_floor" rests the lowest point on the proxy surface below (the table top, not the
+// floor, when the object stands over the table).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <fstream>
+#include <glm/gtc/matrix_transform.hpp>
+
+#include "lumar/base/error.h"
+#include "lumar/scene/loaded_scene.h"
+#include "test_paths.h"
+
+namespace lumar {
+namespace {
+
+class ObjectPose : public ::testing::Test {
+ protected:
+  void SetUp() override { dir_ = test::scratch_dir("object-pose"); }
+  void TearDown() override {
+    std::error_code ignored;
+    std::filesystem::remove_all(dir_, ignored);
+  }
+
+  // The sample room's manifest with its figurine's "pose" replaced.
+  std::filesystem::path manifest(const std::string& pose_json) {
+    const auto src = test::source_dir() / "data/scenes/room";
+    const auto path = dir_ / "scene.json";
+    std::ofstream(path) << R"({"format": "lumar-scene", "version": 1,
+      "room": {"mesh": ")"
+                        << (src / "room.obj").string() << R"("},
+      "environment_map": {"path": ")"
+                        << (test::source_dir() / "data/envmaps/interior.exr").string()
+                        << R"(", "capture_position": [0, 1.4, 0]},
+      "movement_box": {"min": [-1.2, 0.0, -0.4], "max": [0.4, 1.0, 1.2]},
+      "objects": [{"name": "figurine", "mesh": ")"
+                        << (test::source_dir() / "data/models/parasaurolophus_6700.ply").string() << R"(",
+                   "pose": )"
+                        << pose_json << "}]}";
+    return path;
+  }
+
+  std::pair<glm::dvec3, glm::dvec3> posed_bounds(const LoadedScene& s) {
+    const auto [lo, hi] = transformed(s.objects[0].model, s.objects[0].T_world_model).bounds();
+    return {glm::dvec3(lo), glm::dvec3(hi)};
+  }
+
+  std::filesystem::path dir_;
+};
+
+TEST_F(ObjectPose, TheThreeRotationFormsAgree) {
+  const Scene axis = load_scene(manifest(R"({"rotation_axis": [0, 1, 0], "rotation_deg": 30})"));
+  const Scene ypr = load_scene(manifest(R"({"yaw_pitch_roll_deg": [30, 0, 0]})"));
+  const double h = glm::radians(15.0);  // a 30 degree turn about +Y
+  const Scene quat = load_scene(manifest("{\"rotation_wxyz\": [" + std::to_string(std::cos(h)) + ", 0, " +
+                                         std::to_string(std::sin(h)) + ", 0]}"));
+  for (int c = 0; c < 4; ++c)
+    for (int r = 0; r < 4; ++r) {
+      EXPECT_NEAR(axis.objects[0].T_world_model[c][r], ypr.objects[0].T_world_model[c][r], 1e-9);
+      EXPECT_NEAR(axis.objects[0].T_world_model[c][r], quat.objects[0].T_world_model[c][r], 1e-6);
+    }
+  // Yaw, then pitch, then roll: R = Ry Rx Rz. A pitch of 90 turns the model's +Z to -Y.
+  const Scene pitched = load_scene(manifest(R"({"yaw_pitch_roll_deg": [0, 90, 0]})"));
+  const glm::dvec3 z = glm::dmat3(pitched.objects[0].T_world_model) * glm::dvec3(0, 0, 1);
+  EXPECT_NEAR(glm::distance(z, glm::dvec3(0, -1, 0)), 0.0, 1e-12);
+}
+
+TEST_F(ObjectPose, OneRotationFormOnlyAndUnitQuaternions) {
+  EXPECT_THROW(load_scene(manifest(R"({"rotation_deg": 30, "yaw_pitch_roll_deg": [30, 0, 0]})")), InputError);
+  EXPECT_THROW(load_scene(manifest(R"({"rotation_wxyz": [1, 1, 0, 0]})")), InputError);
+  EXPECT_THROW(load_scene(manifest(R"({"model_origin": "top"})")), InputError);
+  EXPECT_THROW(load_scene(manifest(R"({"on_floor": "yes"})")), InputError);
+}
+
+TEST_F(ObjectPose, BottomCentreLandsAtTheTranslation) {
+  const LoadedScene s = load_scene_files(manifest(
+      R"({"translation": [-0.3, 0.2, 0.5], "yaw_pitch_roll_deg": [40, -90, 0], "scale": 0.002, "model_origin": "bottom-centre"})"));
+  const auto [lo, hi] = posed_bounds(s);
+  EXPECT_NEAR(0.5 * (lo.x + hi.x), -0.3, 1e-6);
+  EXPECT_NEAR(lo.y, 0.2, 1e-6);
+  EXPECT_NEAR(0.5 * (lo.z + hi.z), 0.5, 1e-6);
+}
+
+TEST_F(ObjectPose, OnFloorRestsOnTheSurfaceBelow) {
+  // Over the open floor: the lowest point comes down to y = 0.
+  const LoadedScene floor = load_scene_files(manifest(
+      R"({"translation": [0, 0.4, 0.5], "yaw_pitch_roll_deg": [0, -90, 0], "scale": 0.002, "model_origin": "bottom-centre", "on_floor": true})"));
+  EXPECT_NEAR(posed_bounds(floor).first.y, 0.0, 1e-6);
+  // Below the floor, it comes up to it just the same.
+  const LoadedScene sunk = load_scene_files(manifest(
+      R"({"translation": [0, -0.05, 0.5], "yaw_pitch_roll_deg": [0, -90, 0], "scale": 0.002, "model_origin": "bottom-centre", "on_floor": true})"));
+  EXPECT_NEAR(posed_bounds(sunk).first.y, 0.0, 1e-6);
+  // Over the sample room's table (a box up to y = 0.72 around x = 0.9, z = -0.7), on its top.
+  const auto [room_lo, room_hi] = floor.room.bounds();
+  double table_top = 0;
+  for (const glm::vec3& p : floor.room.positions)
+    if (p.y > 0.01f && p.y < room_hi.y - 0.01f) table_top = std::max(table_top, double(p.y));
+  ASSERT_GT(table_top, 0.3);
+  const LoadedScene table = load_scene_files(manifest(
+      R"({"translation": [0.85, 1.5, -0.7], "yaw_pitch_roll_deg": [0, -90, 0], "scale": 0.001, "model_origin": "bottom-centre", "on_floor": true})"));
+  EXPECT_NEAR(posed_bounds(table).first.y, table_top, 1e-6);
+}
+
+}  // namespace
+}  // namespace lumar
