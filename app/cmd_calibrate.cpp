@@ -9,6 +9,7 @@
 #include "commands.h"
 #include "lumar/base/error.h"
 #include "lumar/base/glob.h"
+#include "lumar/base/output_file.h"
 #include "lumar/calib/calibration_report.h"
 #include "lumar/calib/charuco_calibration.h"
 #include "lumar/calib/checkerboard_calibration.h"
@@ -110,8 +111,13 @@ void register_calibrate(CLI::App& app) {
     }
     if (o->images.empty() == o->source.empty())
       throw InputError("calibrate: give either --images or --source (or --video)");
+    const std::vector<std::filesystem::path> inputs =
+        o->source.empty() ? expand(o->images) : std::vector<std::filesystem::path>();
+    refuse_output_over_input(o->out, inputs);
+    refuse_output_over_input(o->coverage, inputs, "--coverage");
+    refuse_output_over_input(o->preview, inputs, "--preview");
     const std::vector<calib::NamedImage> images =
-        o->source.empty() ? calib::load_board_images(expand(o->images)) : frames_from_source(*o);
+        o->source.empty() ? calib::load_board_images(inputs) : frames_from_source(*o);
     // Both boards give views for the same robust solve; the report names inner corners.
     calib::BoardViews views;
     cv::Size board;

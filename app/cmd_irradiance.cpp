@@ -13,6 +13,7 @@
 #include "lumar/base/output_file.h"
 #include "lumar/lighting/irradiance_reference.h"
 #include "lumar/lighting/irradiance_scene.h"
+#include "lumar/scene/query_points.h"
 
 namespace lumar::app {
 
@@ -23,62 +24,6 @@ struct IrradianceOptions {
   bool no_cache = false;
   int strata = 64;
 };
-
-struct Query {
-  std::vector<glm::dvec3> points, normals;
-};
-
-Query read_queries(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw InputError(path + ": query file not found or unreadable; give a CSV with header x,y,z,nx,ny,nz");
-  std::string line;
-  if (!std::getline(in, line)) throw InputError(path + ": empty query file; expected a header x,y,z,nx,ny,nz");
-  std::vector<std::string> header;
-  {
-    std::stringstream ss(line);
-    std::string cell;
-    while (std::getline(ss, cell, ',')) {
-      cell.erase(0, cell.find_first_not_of(" \t\r"));
-      cell.erase(cell.find_last_not_of(" \t\r") + 1);
-      header.push_back(cell);
-    }
-  }
-  const char* names[6] = {"x", "y", "z", "nx", "ny", "nz"};
-  int column[6];
-  for (int k = 0; k < 6; ++k) {
-    const auto it = std::find(header.begin(), header.end(), names[k]);
-    if (it == header.end())
-      throw InputError(path + ": header has no column '" + names[k] + "'; expected x,y,z,nx,ny,nz");
-    column[k] = int(it - header.begin());
-  }
-  Query q;
-  int number = 1;
-  while (std::getline(in, line)) {
-    ++number;
-    if (line.find_first_not_of(" \t\r") == std::string::npos) continue;
-    std::vector<double> values;
-    std::stringstream ss(line);
-    std::string cell;
-    while (std::getline(ss, cell, ',')) {
-      char* end = nullptr;
-      const double v = std::strtod(cell.c_str(), &end);
-      while (end && (*end == ' ' || *end == '\t' || *end == '\r')) ++end;
-      if (cell.empty() || !end || *end != '\0' || !std::isfinite(v))
-        throw InputError(path + ": line " + std::to_string(number) + ": '" + cell + "' is not a number");
-      values.push_back(v);
-    }
-    if (values.size() != header.size())
-      throw InputError(path + ": line " + std::to_string(number) + ": expected " + std::to_string(header.size()) +
-                       " values like the header, got " + std::to_string(values.size()));
-    const glm::dvec3 p(values[column[0]], values[column[1]], values[column[2]]);
-    const glm::dvec3 n(values[column[3]], values[column[4]], values[column[5]]);
-    if (glm::length(n) < 1e-9)
-      throw InputError(path + ": line " + std::to_string(number) + ": the normal (nx, ny, nz) is zero");
-    q.points.push_back(p);
-    q.normals.push_back(glm::normalize(n));
-  }
-  return q;
-}
 
 void write_results(const std::string& path, const std::vector<glm::dvec3>& e) {
   std::string csv = "r,g,b\n";
@@ -93,7 +38,8 @@ void write_results(const std::string& path, const std::vector<glm::dvec3>& e) {
 void run(const IrradianceOptions& o) {
   if (o.scene.empty() == o.envmap.empty())
     throw InputError("lumar irradiance: give either --scene S or --envmap MAP.exr");
-  const Query q = read_queries(o.query);
+  refuse_output_over_input(o.out, {o.query, o.scene, o.envmap});
+  const QueryPoints q = read_query_points(o.query);
   // A scene, or a distant map alone: either way its files are decoded once, here.
   Scene manifest;
   if (!o.scene.empty()) {

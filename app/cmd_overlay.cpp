@@ -1,5 +1,6 @@
 // lumar overlay: composite the scene's virtual objects into a recording's video
 // (pipeline/replay_overlay.h), or live into a camera's (pipeline/live_overlay.h).
+#include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
 #include <memory>
@@ -7,6 +8,7 @@
 
 #include "commands.h"
 #include "lumar/base/error.h"
+#include "lumar/base/stop_signal.h"
 #include "lumar/pipeline/live_overlay.h"
 #include "lumar/pipeline/output_files.h"
 #include "lumar/pipeline/progress.h"
@@ -94,7 +96,10 @@ void run_replay(const OverlayOptions& o) {
   pipeline::ReplayOverlay overlay(o.recording, settings);
   const auto& camera = overlay.compositor().output_camera();
   std::int64_t total = std::int64_t(overlay.replay().reader().frames().size());
+  if (total == 0)  // an empty video would look like a result
+    throw InputError(o.recording + ": has no frames to composite (frames.csv lists none)");
   if (o.max_frames > 0) total = std::min<std::int64_t>(total, o.max_frames);
+  catch_stop_signals();  // from here on Ctrl-C stops between frames, and nothing is committed
   pipeline::OverlayOutputs outputs({o.out, o.frames_dir, o.contact_sheet, overlay.replay().reader().video().fps,
                                     cv::Size(camera.width, camera.height), total});
   pipeline::Progress progress("overlay", int(total), "frames", true);  // on a terminal only
@@ -103,9 +108,11 @@ void run_replay(const OverlayOptions& o) {
   overlay.run(o.max_frames, [&](const pipeline::OverlayFrame& f) {
     const bool go_on = sink(f);
     progress.update(++done);
-    return go_on;
+    return go_on && !stop_requested();
   });
   progress.finish();
+  if (stop_requested())
+    throw Interrupted(fmt::format("overlay: after {} of {} frames; no output written", done, total));
   outputs.commit();
   const auto& stats = overlay.replay().tracker_stats();
   spdlog::info("overlay: {} frames{}; tracker: {} records, {} rejected, {} bytes skipped", overlay.times().frames,

@@ -11,6 +11,7 @@
 
 #include "commands.h"
 #include "lumar/base/error.h"
+#include "lumar/base/json_file.h"
 #include "lumar/base/output_file.h"
 #include "lumar/calib/image_file.h"
 #include "lumar/pipeline/replay_overlay.h"
@@ -71,16 +72,6 @@ double render_vs_opencv_px(Compositor& compositor, const Pose& T_world_camera, s
   return sum / world.size();
 }
 
-json read_json(const fs::path& file) {
-  std::ifstream in(file);
-  if (!in) throw InputError(file.string() + ": cannot read");
-  try {
-    return json::parse(in);
-  } catch (const json::parse_error& e) {
-    throw InputError(file.string() + ": malformed JSON (" + e.what() + ")");
-  }
-}
-
 struct Outcome {
   bool pass = true;
   std::string line;
@@ -94,7 +85,7 @@ Outcome regress_one(const fs::path& dir, const RegressOptions& o) {
                      ": missing; make the golden frames and expectations once with: lumar "
                      "regress --update " +
                      dir.string());
-  json expected = update ? json::object() : read_json(expected_file);
+  json expected = update ? json::object() : read_json_file(expected_file, "expectations file");
   std::vector<std::int64_t> golden;
   if (!update) golden = expected.at("golden_frames").get<std::vector<std::int64_t>>();
 

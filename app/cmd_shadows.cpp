@@ -11,6 +11,7 @@
 #include "lumar/base/output_file.h"
 #include "lumar/lighting/shadows/shadow_methods.h"
 #include "lumar/scene/loaded_scene.h"
+#include "lumar/scene/query_points.h"
 
 namespace lumar::app {
 
@@ -19,48 +20,6 @@ namespace {
 struct ShadowsOptions {
   std::string scene, query, out, method = "lines";
 };
-
-// IN.csv: a header, then x,y,z,nx,ny,nz per line (normals need not be unit).
-void read_query(const std::filesystem::path& path, std::vector<glm::vec3>& positions, std::vector<glm::vec3>& normals) {
-  if (!std::filesystem::is_regular_file(path))
-    throw InputError(path.string() + ": query file not found; check the path");
-  std::ifstream in(path);
-  if (!in) throw InputError(path.string() + ": cannot open the query file for reading");
-  std::string line;
-  if (!std::getline(in, line) || line.find('x') == std::string::npos)
-    throw InputError(path.string() + ": line 1: expected the header x,y,z,nx,ny,nz");
-  for (int number = 2; std::getline(in, line); ++number) {
-    if (!line.empty() && line.back() == '\r') line.pop_back();
-    if (line.find_first_not_of(" \t") == std::string::npos) continue;
-    std::stringstream ss(line);
-    std::string cell;
-    double v[6];
-    int n = 0;
-    while (std::getline(ss, cell, ',')) {
-      std::size_t used = 0;
-      double d = 0;
-      try {
-        d = std::stod(cell, &used);
-      } catch (const std::exception&) {
-        used = 0;
-      }
-      if (used == 0 || cell.find_first_not_of(" \t", used) != std::string::npos || !std::isfinite(d) || n >= 6) {
-        n = -1;
-        break;
-      }
-      v[n++] = d;
-    }
-    if (n != 6)
-      throw InputError(path.string() + ": line " + std::to_string(number) +
-                       ": expected 6 finite numbers x,y,z,nx,ny,nz separated by commas");
-    const glm::dvec3 nrm(v[3], v[4], v[5]);
-    if (glm::length(nrm) < 1e-12)
-      throw InputError(path.string() + ": line " + std::to_string(number) + ": the normal must not be zero");
-    positions.emplace_back(v[0], v[1], v[2]);
-    normals.push_back(glm::vec3(glm::normalize(nrm)));
-  }
-  if (positions.empty()) throw InputError(path.string() + ": no points after the header; add x,y,z,nx,ny,nz rows");
-}
 
 void write_result(const std::filesystem::path& path, const std::vector<glm::vec3>& attenuation) {
   std::string csv = "r,g,b\n";
@@ -86,8 +45,10 @@ void register_shadows(CLI::App& app) {
   add_action(cmd, [o] {
     const ShadowMethod method = parse_shadow_method(o->method);
     LoadedScene scene = load_scene_files(std::filesystem::path(o->scene));
-    std::vector<glm::vec3> positions, normals;
-    read_query(o->query, positions, normals);
+    refuse_output_over_input(o->out, {o->query, o->scene});
+    const QueryPoints q = read_query_points(o->query);
+    const std::vector<glm::vec3> positions(q.points.begin(), q.points.end()),
+        normals(q.normals.begin(), q.normals.end());
     const ShadowScene shadows(std::move(scene));
     const auto attenuation = shadow_attenuation(shadows, positions, normals, method);
     write_result(o->out, attenuation);

@@ -4,6 +4,7 @@
 
 #include "commands.h"
 #include "lumar/base/error.h"
+#include "lumar/base/stop_signal.h"
 #include "lumar/calib/camera_file.h"
 #include "lumar/sim/synthetic_board.h"
 #include "lumar/sim/synthetic_recording.h"
@@ -79,6 +80,7 @@ void register_synth(CLI::App& app) {
   auto sweep = std::make_shared<SweepOptions>();
   add_sweep_options(cmd, *sweep);
   add_action(cmd, [cmd, s, camera_file, b, board, sweep] {
+    catch_stop_signals();  // Ctrl-C stops between frames; the unfinished recording is removed
     if (sweep->sweep) {
       if (sweep->envmap.empty()) throw InputError("synth --sweep: give the map to sweep with --envmap MAP.exr");
       sim::SweepSynthSettings settings = sweep->settings;

@@ -62,6 +62,7 @@ void run_decode(const DecodeOptions& o) {
   } catch (const InputError& e) {
     throw InputError(std::string("tracker decode: ") + e.what());
   }
+  if (o.out != "-") refuse_output_over_input(o.out, {o.file});
   const std::string data = read_file(o.file);
 
   std::vector<tracking::ByteChunk> chunks;

@@ -13,7 +13,7 @@
 
 #include "commands.h"
 #include "lumar/base/error.h"
-#include "lumar/pipeline/stop_signal.h"
+#include "lumar/base/stop_signal.h"
 #include "lumar/tracking/tracker_decode.h"
 #include "lumar/tracking/tracker_emulator.h"
 
@@ -108,7 +108,7 @@ void run_emulate(const EmulateOptions& o) {
     *log << row << std::flush;
   };
 
-  pipeline::catch_stop_signals();
+  catch_stop_signals();
   tracking::TrackerEmulator emulator(s, on_record);
   const auto describe = [&](const std::string& port) {
     std::printf("%s %s on %s", tracking::device_name(s.device).c_str(), port.empty() ? "disconnected" : "ready",
@@ -120,7 +120,7 @@ void run_emulate(const EmulateOptions& o) {
   std::string port = emulator.port_path();
   describe(port);
   const Nanos end = o.duration_s > 0 ? monotonic_now() + seconds_to_nanos(o.duration_s) : 0;
-  while (!pipeline::stop_requested() && (end == 0 || monotonic_now() < end)) {
+  while (!stop_requested() && (end == 0 || monotonic_now() < end)) {
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
     if (const std::string now = emulator.port_path(); now != port) describe(port = now);
     if (const std::string why = emulator.failure(); !why.empty()) throw RuntimeError("emulator stopped: " + why);

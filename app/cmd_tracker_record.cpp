@@ -12,8 +12,8 @@
 
 #include "commands.h"
 #include "lumar/base/error.h"
+#include "lumar/base/stop_signal.h"
 #include "lumar/capture/recording_writer.h"
-#include "lumar/pipeline/stop_signal.h"
 #include "lumar/tracking/tracker_driver.h"
 
 namespace lumar::app {
@@ -114,7 +114,7 @@ void run_record(const RecordOptions& o) {
   video.size = {1, 1};
   capture::RecordingWriter writer(o.out, session, video);
 
-  pipeline::catch_stop_signals();
+  catch_stop_signals();
   const Nanos start = monotonic_now();
   tracking::TrackerDriver driver(d, tracking::serial_port(serial), [&](const tracking::ByteChunk& chunk) {
     tracking::ByteChunk since_start{chunk.arrival - start, chunk.bytes};
@@ -139,7 +139,7 @@ void run_record(const RecordOptions& o) {
     }
   };
   const Nanos end = o.duration_s > 0 ? start + seconds_to_nanos(o.duration_s) : 0;
-  while (!pipeline::stop_requested() && (end == 0 || monotonic_now() < end)) {
+  while (!stop_requested() && (end == 0 || monotonic_now() < end)) {
     std::this_thread::sleep_for(std::chrono::milliseconds(10));
     drain();
     const auto st = driver.status();

@@ -39,6 +39,9 @@ int main(int argc, char** argv) {
   } catch (const lumar::InputError& e) {
     std::fprintf(stderr, "lumar: error: %s\n", e.what());
     return 2;
+  } catch (const lumar::Interrupted& e) {
+    std::fprintf(stderr, "lumar: stopped: %s\n", e.what());
+    return 130;
   } catch (const lumar::RuntimeError& e) {
     std::fprintf(stderr, "lumar: failed: %s\n", e.what());
     return 1;

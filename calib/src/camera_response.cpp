@@ -9,6 +9,7 @@
 
 #include "lumar/base/color.h"
 #include "lumar/base/error.h"
+#include "lumar/base/json_file.h"
 #include "lumar/base/output_file.h"
 
 namespace lumar::calib {
@@ -112,14 +113,7 @@ cv::Mat linearize(const cv::Mat& image8, const CameraResponse& response) {
 
 CameraResponse load_camera_response(const std::filesystem::path& path) {
   const std::string name = path.string();
-  std::ifstream in(path);
-  if (!in) throw InputError(name + ": camera response file not found or unreadable");
-  nlohmann::json j;
-  try {
-    in >> j;
-  } catch (const nlohmann::json::exception&) {
-    throw InputError(name + ": not valid JSON; rewrite it with `lumar` or fix the syntax");
-  }
+  const nlohmann::json j = read_json_file(path, "camera response file");
   const auto format = j.is_object() ? j.find("format") : j.end();
   if (!j.is_object() || format == j.end() || *format != "lumar-camera-response")
     throw InputError(name + ": not a camera response file (\"format\" must be \"lumar-camera-response\")");

@@ -4,6 +4,7 @@
 
 #include "csv_text.h"
 #include "lumar/base/error.h"
+#include "lumar/base/json_file.h"
 #include "lumar/capture/recording_source.h"
 #include "lumar/capture/tracker_raw.h"
 
@@ -50,12 +51,7 @@ RecordingReader::RecordingReader(const fs::path& dir) : dir_(dir) {
     throw InputError(session_file.string() + ": missing; " + dir.string() +
                      " is not a Lumar recording (or its writer died before starting)");
   const std::string text = csv::read_file(session_file);
-  nlohmann::json session_;
-  try {
-    session_ = nlohmann::json::parse(text);
-  } catch (const nlohmann::json::parse_error& e) {
-    throw InputError(session_file.string() + ": malformed JSON (" + e.what() + "); repair it by hand or restore it");
-  }
+  const nlohmann::json session_ = parse_json_text(text, session_file);
   if (!session_.is_object())
     throw InputError(session_file.string() + ": malformed session (not a JSON object); repair it" +
                      " by hand or restore it");

@@ -4,6 +4,7 @@
 #include <fstream>
 
 #include "lumar/base/error.h"
+#include "lumar/base/json_file.h"
 #include "lumar/base/output_file.h"
 #include "lumar/capture/recording_format.h"
 
@@ -257,32 +258,18 @@ Session session_from_json(const json& j, const std::string& file) {
   try {
     return parse_session(j, file);
   } catch (const json::exception& e) {
-    throw InputError(file + ": unexpected value (" + e.what() + ")");
+    throw InputError(file + ": unexpected value (" + json_error_text(e) + ")");
   }
 }
-
-namespace {
-
-json read_json_file(const std::filesystem::path& file) {
-  std::ifstream in(file);
-  if (!in) throw InputError(file.string() + ": cannot read it; check the path (a recording's session.json)");
-  try {
-    return json::parse(in);
-  } catch (const json::exception& e) {
-    throw InputError(file.string() + ": malformed JSON (" + e.what() + ")");
-  }
-}
-
-}  // namespace
 
 Session load_session_file(const std::filesystem::path& file) {
-  return session_from_json(read_json_file(file), file.string());
+  return session_from_json(read_json_file(file, "session file"), file.string());
 }
 
 void update_session_file(const std::filesystem::path& dir, const std::function<void(Session&)>& change,
                          const json& set_keys) {
   const std::filesystem::path file = dir / kSessionFile;
-  json j = read_json_file(file);
+  json j = read_json_file(file, "session file");
   Session session = session_from_json(j, file.string());
   change(session);
   const json updated = session_to_json(session);

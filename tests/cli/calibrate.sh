@@ -115,6 +115,18 @@ case_too_few_views() {
     "$LUMAR" calibrate --images "$BOARDS/left01.jpg" --images "$BOARDS/left03.jpg" --out "$TMP/cam.yml"
 }
 
+case_output_over_an_input_image_is_refused() {
+  # `--out d/left01.jpg` turned the photograph into YAML; now exit 2 and it is untouched.
+  mkdir "$TMP/d"
+  cp "$BOARDS"/left0[1-6].jpg "$TMP/d/"
+  cp "$TMP/d/left01.jpg" "$TMP/before.jpg"
+  expect_bad_input "is an input" "" -- "$LUMAR" calibrate --images "$TMP/d/*.jpg" --out "$TMP/d/left01.jpg"
+  expect_bad_input "--coverage" "" -- "$LUMAR" calibrate --images "$TMP/d/*.jpg" --out "$TMP/c.yml" \
+    --coverage "$TMP/d/left02.jpg"
+  cmp -s "$TMP/d/left01.jpg" "$TMP/before.jpg" || fail "the input image was changed"
+  [ ! -e "$TMP/c.yml" ] || fail "an output was written"
+}
+
 case_unreadable_image() {
   printf 'not a jpeg' >"$TMP/broken.jpg"
   expect_bad_input "$TMP/broken.jpg" "$TMP/cam.yml" -- \

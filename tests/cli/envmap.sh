@@ -84,6 +84,21 @@ case_dark_regions_are_named() {
   ! grep -q "below code 16" "$TMP/log" || { cat "$TMP/log"; fail "warned although +4 lifts the dark regions"; }
 }
 
+case_signals_stop_cleanly() {
+  # SIGINT and SIGTERM while stitching: exit 130 within 2 s, no map and no temporary; a
+  # later run is unaffected.
+  "$LUMAR" synth --sweep --envmap "$MAP" --camera "$CAM" --out "$TMP/rec" --frames 180 --supersample 1 \
+    --codec ffv1 >"$TMP/synth.log" 2>&1 || { cat "$TMP/synth.log"; fail "synth --sweep failed"; }
+  mkdir "$TMP/out"
+  for signal in INT TERM; do
+    stop_midway "$signal" "stderr:features: 1" -- "$LUMAR" envmap --recording "$TMP/rec" --out "$TMP/out/map.exr"
+    [ -z "$(ls -A "$TMP/out")" ] || fail "left after SIG$signal: $(ls -A "$TMP/out")"
+  done
+  "$LUMAR" envmap --recording "$TMP/rec" --out "$TMP/out/map.exr" --width 256 >"$TMP/log" 2>&1 \
+    || { cat "$TMP/log"; fail "later run"; }
+  is_exr "$TMP/out/map.exr" || fail "the later run wrote no map"
+}
+
 case_envmap_no_frames() {
   small_sweep "$TMP/rec"
   head -1 "$TMP/rec/frames.csv" >"$TMP/frames" && mv "$TMP/frames" "$TMP/rec/frames.csv"

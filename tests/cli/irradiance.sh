@@ -80,6 +80,15 @@ case_bad_query_file() {
   printf 'x,y,z,nx,ny,nz\n0,0,0,0,0,0\n' >"$TMP/bad.csv"
   expect_bad_input "zero" "$TMP/out.csv" -- \
     "$LUMAR" irradiance --envmap "$TMP/u.hdr" --query "$TMP/bad.csv" --out "$TMP/out.csv"
+  # A header alone was 0 points and exit 0 here, exit 2 in shadows: now exit 2 in both.
+  printf 'x,y,z,nx,ny,nz\n' >"$TMP/bad.csv"
+  expect_bad_input "no points" "$TMP/out.csv" -- \
+    "$LUMAR" irradiance --envmap "$TMP/u.hdr" --query "$TMP/bad.csv" --out "$TMP/out.csv"
+  # A point at 1e30 aborted inside Embree (SIGABRT, exit 134) under the reference.
+  printf 'x,y,z,nx,ny,nz\n1e30,0,0,0,1,0\n' >"$TMP/bad.csv"
+  expect_bad_input "line 2: the point lies beyond" "$TMP/out.csv" -- \
+    "$LUMAR" irradiance --scene "$SRC/data/scenes/room/scene.json" --method reference --query "$TMP/bad.csv" \
+    --out "$TMP/out.csv"
 }
 
 case_bad_method_and_map() {

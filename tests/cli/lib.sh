@@ -78,3 +78,54 @@ run_case() {
   declare -F "case_$CASE" >/dev/null || fail "no case '$CASE' in $0"
   "case_$CASE"
 }
+
+# expect_environment_error WHAT_STDERR_MUST_SAY DIR -- command...: a failure of the
+# environment (a full disk, a read-only folder): exit 1, one line on stderr saying it,
+# nothing final and no temporary left in DIR besides what was there before (DIR "-":
+# not checked).
+expect_environment_error() {
+  local must_say=$1 dir=$2
+  shift 3
+  local before status=0
+  [ "$dir" = - ] || before=$(ls -A "$dir" | sort)
+  "$@" >"$TMP/stdout" 2>"$TMP/stderr" || status=$?
+  [ $status -eq 1 ] || { cat "$TMP/stderr" >&2; fail "exit status $status, expected 1: $*"; }
+  [ "$(grep -c . "$TMP/stderr")" -eq 1 ] || { cat "$TMP/stderr" >&2; fail "expected one line on stderr"; }
+  grep -qF -- "$must_say" "$TMP/stderr" || { cat "$TMP/stderr" >&2; fail "stderr does not say '$must_say'"; }
+  [ "$dir" = - ] || [ "$(ls -A "$dir" | sort)" = "$before" ] || fail "left in $dir: $(comm -13 <(echo "$before") <(ls -A "$dir" | sort) | tr '\n' ' ')"
+  echo "ok: $(head -1 "$TMP/stderr")"
+}
+
+# with_file_size_limit KB command...: runs the command as if the disk filled up after KB
+# kilobytes per file (RLIMIT_FSIZE; writes past it fail with EFBIG, SIGXFSZ ignored).
+with_file_size_limit() {
+  local kb=$1
+  shift
+  (trap '' XFSZ; ulimit -f "$kb"; exec "$@")  # bash counts -f in 1024-byte blocks
+}
+
+# stop_midway SIGNAL WAIT_FOR -- command...: starts the command, waits until the work is
+# under way (WAIT_FOR: a glob a file must match, or "stderr:TEXT" the command must have
+# printed), sends the signal, and expects exit 130 within 2 s with a "stopped" line.
+stop_midway() {
+  local signal=$1 glob=$2
+  shift 3
+  "$@" >"$TMP/stdout" 2>"$TMP/stderr" &
+  local pid=$! waited=0
+  PIDS+=("$pid")
+  until if [ "${glob#stderr:}" != "$glob" ]; then grep -q "${glob#stderr:}" "$TMP/stderr"; else compgen -G "$glob" >/dev/null; fi; do
+    kill -0 "$pid" 2>/dev/null || { cat "$TMP/stderr"; fail "the command ended before $glob appeared"; }
+    sleep 0.05
+    waited=$((waited + 1))
+    [ $waited -lt 2400 ] || fail "$glob did not appear within 120 s"
+  done
+  sleep 0.3
+  kill -"$signal" "$pid"
+  local start=$(date +%s%N) status=0
+  wait "$pid" || status=$?
+  local ms=$((($(date +%s%N) - start) / 1000000))
+  [ $status -eq 130 ] || { cat "$TMP/stderr"; fail "exit status $status after SIG$signal, expected 130"; }
+  [ $ms -lt 2000 ] || fail "took $ms ms to stop after SIG$signal"
+  grep -q "^lumar: stopped:" "$TMP/stderr" || { cat "$TMP/stderr"; fail "no 'stopped' line"; }
+  echo "ok: SIG$signal stopped it in $ms ms: $(grep '^lumar: stopped' "$TMP/stderr")"
+}

@@ -17,6 +17,47 @@ case_headless_writes_video_and_frames() {
   cat "$TMP/log"
 }
 
+case_full_disk_is_an_error() {
+  # A disk that fills up at 100 KB per file (the video takes about 190 KB): the encoder's writes fail silently, so the
+  # video is read back; exit 1, one line, no video and no temporary. The same for PNG
+  # frames. (Before: exit 0 and "48 frames -> o.mp4" over a cut file.)
+  mkdir "$TMP/out"
+  expect_environment_error "could not be written whole" "$TMP/out" -- \
+    with_file_size_limit 100 "$LUMAR" overlay --recording "$REC" --out "$TMP/out/o.mp4" --no-cache
+  expect_environment_error "cannot write PNG" "$TMP/out" -- \
+    with_file_size_limit 100 "$LUMAR" overlay --recording "$REC" --frames-dir "$TMP/out/frames" --no-cache
+}
+
+case_signals_stop_cleanly() {
+  # SIGINT and SIGTERM mid-run: exit 130 within 2 s, no video and no temporary (before:
+  # a ".o.partial.mp4" was left); a later run is unaffected.
+  mkdir "$TMP/out"
+  for signal in INT TERM; do
+    stop_midway "$signal" "$TMP/out/.o.partial-*" -- \
+      "$LUMAR" overlay --recording "$REC" --out "$TMP/out/o.mp4" --frames-dir "$TMP/out/frames"
+    [ -z "$(ls -A "$TMP/out")" ] || fail "left after SIG$signal: $(ls -A "$TMP/out")"
+  done
+  "$LUMAR" overlay --recording "$REC" --out "$TMP/out/o.mp4" >"$TMP/log" 2>&1 || { cat "$TMP/log"; fail "later run"; }
+  [ -s "$TMP/out/o.mp4" ] || fail "the later run wrote no video"
+}
+
+case_recording_without_frames_is_refused() {
+  # A recording whose frames.csv lists no frame gave exit 0 and a 0-frame video.
+  cp -r "$REC" "$TMP/rec"
+  head -1 "$REC/frames.csv" >"$TMP/rec/frames.csv"
+  expect_bad_input "$TMP/rec" "$TMP/o.mp4" -- "$LUMAR" overlay --recording "$TMP/rec" --out "$TMP/o.mp4" \
+    --scene "$SRC/data/scenes/room/scene.json"
+}
+
+case_read_only_folder_is_named() {
+  # A folder the video cannot be created in: exit 1, the reason in one line (before: "no
+  # video encoder available"). Root ignores permissions, so the folder is /proc, which no
+  # one can create files in.
+  expect_environment_error "cannot create the video" - -- \
+    "$LUMAR" overlay --recording "$REC" --out /proc/o.mp4 --no-cache
+  [ -z "$(ls -A /proc | grep 'partial')" ] || fail "a temporary was left in /proc"
+}
+
 case_window_under_xvfb() {
   command -v xvfb-run >/dev/null || fail "xvfb-run is not installed"
   xvfb-run -a -s "-screen 0 1024x768x24" "$LUMAR" overlay --recording "$REC" --window --max-frames 3 \

@@ -56,6 +56,24 @@ case_default_method_is_lines() {
   cmp -s "$TMP/default.csv" "$TMP/lines.csv" || fail "the default method is not lines"
 }
 
+case_query_columns_go_by_the_header() {
+  # The header names the columns: the same points written nz,ny,nx,z,y,x give the same
+  # answer (before, columns were read by position: 1.0 instead of 0.990).
+  write_query
+  python3 - "$TMP/in.csv" "$TMP/reordered.csv" <<'PY'
+import csv, sys
+rows = list(csv.reader(open(sys.argv[1])))
+with open(sys.argv[2], "w") as f:
+    for r in rows:
+        f.write(",".join(reversed(r)) + "\n")
+PY
+  head -1 "$TMP/reordered.csv" | grep -q "^nz,ny,nx,z,y,x$" || fail "the reordered header is wrong"
+  "$LUMAR" shadows --scene "$SCENE" --query "$TMP/in.csv" --out "$TMP/a.csv" 2>/dev/null || fail "run failed"
+  "$LUMAR" shadows --scene "$SCENE" --query "$TMP/reordered.csv" --out "$TMP/b.csv" 2>/dev/null || fail "run failed"
+  cmp -s "$TMP/a.csv" "$TMP/b.csv" || fail "the answer depends on the column order"
+  check_csv a.csv "min(min(r) for r in a) < 0.995"  # some points are shadowed, so the test can fail
+}
+
 case_bad_input() {
   write_query
   expect_bad_input "nope.csv" "$TMP/o1.csv" -- "$LUMAR" shadows --scene "$SCENE" --query "$TMP/nope.csv" --out "$TMP/o1.csv"
@@ -65,6 +83,8 @@ case_bad_input() {
   expect_bad_input "zero.csv: line 2" "$TMP/o3.csv" -- "$LUMAR" shadows --scene "$SCENE" --query "$TMP/zero.csv" --out "$TMP/o3.csv"
   printf 'x,y,z,nx,ny,nz\n0,0,abc,0,1,0\n' >"$TMP/text.csv"
   expect_bad_input "text.csv: line 2" "$TMP/o4.csv" -- "$LUMAR" shadows --scene "$SCENE" --query "$TMP/text.csv" --out "$TMP/o4.csv"
+  printf 'x,y,z,nx,ny,nz\n' >"$TMP/header-only.csv"
+  expect_bad_input "header-only.csv: no points" "$TMP/o8.csv" -- "$LUMAR" shadows --scene "$SCENE" --query "$TMP/header-only.csv" --out "$TMP/o8.csv"
   printf '0,0,0,0,1,0\n' >"$TMP/noheader.csv"
   expect_bad_input "noheader.csv" "$TMP/o5.csv" -- "$LUMAR" shadows --scene "$SCENE" --query "$TMP/noheader.csv" --out "$TMP/o5.csv"
   expect_bad_input "--method" "$TMP/o6.csv" -- "$LUMAR" shadows --scene "$SCENE" --query "$TMP/in.csv" --out "$TMP/o6.csv" --method bogus

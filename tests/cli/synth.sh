@@ -3,6 +3,20 @@ source "$(dirname "$0")/lib.sh"
 SCENE=$SRC/data/scenes/room/scene.json
 CAM=$SRC/data/camera/webcam-640x480.yml
 
+case_signals_stop_cleanly() {
+  # SIGINT and SIGTERM mid-run: exit 130 within 2 s and the unfinished recording removed
+  # (before: a folder with "complete": false and no frames, which overlay then replayed
+  # as a 0-frame video); a later run into the same folder works.
+  for signal in INT TERM; do
+    stop_midway "$signal" "$TMP/rec/session.json" -- \
+      "$LUMAR" synth --scene "$SCENE" --camera "$CAM" --out "$TMP/rec" --frames 400 --supersample 1
+    [ ! -e "$TMP/rec" ] || fail "the unfinished recording is left after SIG$signal"
+  done
+  "$LUMAR" synth --scene "$SCENE" --camera "$CAM" --out "$TMP/rec" --frames 4 --supersample 1 >"$TMP/log" 2>&1 \
+    || { cat "$TMP/log"; fail "later run"; }
+  grep -q '"complete": true' "$TMP/rec/session.json" || fail "the later recording is not complete"
+}
+
 case_synth_then_regress() {
   "$LUMAR" synth --scene "$SCENE" --camera "$CAM" --out "$TMP/rec" --frames 6 --fps 12 --supersample 1 \
     >"$TMP/log" 2>&1 || { cat "$TMP/log"; fail "synth failed"; }

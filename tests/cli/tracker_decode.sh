@@ -39,6 +39,21 @@ case_ascii_with_garbage() {
   echo "ok: $(cat "$TMP/stderr")"
 }
 
+case_output_over_its_input_is_refused() {
+  # `--out` naming the input (directly or through a link) destroyed it; now exit 2, one
+  # line, and the input is untouched.
+  printf '%s' "$REC1" "$REC2" >"$TMP/t.raw"
+  cp "$TMP/t.raw" "$TMP/before.raw"
+  ln -s t.raw "$TMP/link.raw"
+  for out in "$TMP/t.raw" "$TMP/link.raw" "$TMP/./t.raw"; do
+    local status=0
+    "$LUMAR" tracker decode "$TMP/t.raw" --out "$out" >"$TMP/stdout" 2>"$TMP/stderr" || status=$?
+    [ $status -eq 2 ] || { cat "$TMP/stderr"; fail "exit $status for --out $out, expected 2"; }
+    [ "$(grep -c . "$TMP/stderr")" -eq 1 ] && grep -q "is an input" "$TMP/stderr" || { cat "$TMP/stderr"; fail "message"; }
+    cmp -s "$TMP/t.raw" "$TMP/before.raw" || fail "the input was changed by --out $out"
+  done
+}
+
 case_isotrak_binary() {
   # The hand-packed ISOTRAK II binary record of tests/tracking/record_codec_test.cpp
   # (list 2,11, counts x=1000, y=-1, z=200 at 166.32 cm / 32767; q = (28378, -16384,

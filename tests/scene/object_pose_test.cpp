@@ -4,9 +4,12 @@
 // floor, when the object stands over the table).
 #include <gtest/gtest.h>
 
+#include <spdlog/sinks/ostream_sink.h>
+#include <spdlog/spdlog.h>
 #include <cmath>
 #include <fstream>
 #include <glm/gtc/matrix_transform.hpp>
+#include <sstream>
 
 #include "lumar/base/error.h"
 #include "lumar/scene/loaded_scene.h"
@@ -100,6 +103,32 @@ TEST_F(ObjectPose, OnFloorRestsOnTheSurfaceBelow) {
   const LoadedScene table = load_scene_files(manifest(
       R"({"translation": [0.85, 1.5, -0.7], "yaw_pitch_roll_deg": [0, -90, 0], "scale": 0.001, "model_origin": "bottom-centre", "on_floor": true})"));
   EXPECT_NEAR(posed_bounds(table).first.y, table_top, 1e-6);
+}
+
+TEST_F(ObjectPose, StandingOutsideTheMovementBoxOrTheRoomIsWarned) {
+  std::ostringstream log;
+  auto sink = std::make_shared<spdlog::sinks::ostream_sink_mt>(log);
+  spdlog::default_logger()->sinks().push_back(sink);
+  const auto warnings = [&](const std::string& pose) {
+    log.str("");
+    load_scene_files(manifest(pose));
+    return log.str();
+  };
+  // Inside both: silent.
+  const std::string inside = warnings(
+      R"({"translation": [-0.3, 0, 0.5], "yaw_pitch_roll_deg": [0, 0, 90], "scale": 0.002, "model_origin": "bottom-centre"})");
+  // Inside the room, beyond the movement box (x <= 0.4): the lighting is extrapolated.
+  const std::string beyond_box = warnings(
+      R"({"translation": [1.0, 0, 0.5], "yaw_pitch_roll_deg": [0, 0, 90], "scale": 0.002, "model_origin": "bottom-centre"})");
+  // Far outside the room too.
+  const std::string outside = warnings(
+      R"({"translation": [20, 0, 0.5], "yaw_pitch_roll_deg": [0, 0, 90], "scale": 0.002, "model_origin": "bottom-centre"})");
+  spdlog::default_logger()->sinks().pop_back();
+  EXPECT_EQ(inside, "");
+  EXPECT_NE(beyond_box.find("objects[0] (figurine): stands outside the movement box"), std::string::npos) << beyond_box;
+  EXPECT_EQ(beyond_box.find("outside the proxy room"), std::string::npos) << beyond_box;
+  EXPECT_NE(outside.find("stands outside the movement box"), std::string::npos) << outside;
+  EXPECT_NE(outside.find("reaches outside the proxy room"), std::string::npos) << outside;
 }
 
 }  // namespace

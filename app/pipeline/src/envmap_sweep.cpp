@@ -14,6 +14,7 @@
 #include "lumar/base/latlong.h"
 #include "lumar/base/output_file.h"
 #include "lumar/base/pose.h"
+#include "lumar/base/stop_signal.h"
 #include "lumar/calib/image_file.h"
 #include "lumar/envmap/clipped_sources.h"
 #include "lumar/envmap/envmap_quality.h"
@@ -113,10 +114,13 @@ void warn_about_exposure_range(const calib::EnvmapStitcher& stitcher, const std:
 void stitch_sweep(const SweepInput& in, const EnvmapOutputOptions& o) {
   const int n = int(in.rotations.size());
   if (n == 0) throw InputError(in.name + ": no frames; a sweep needs at least one");
+  // Ctrl-C stops between frames, before any output is written.
+  catch_stop_signals();
   auto read_all = [&](const std::string& what, const std::function<void(const cv::Mat&, int)>& use) {
     Progress progress(what, n);
     int done = 0;
     in.read_frames([&](const cv::Mat& image, int k) {
+      if (stop_requested()) throw Interrupted(fmt::format("envmap: {} {} of {} frames; no map written", what, done, n));
       use(image, k);
       progress.update(++done);
     });

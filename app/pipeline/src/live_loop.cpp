@@ -5,7 +5,7 @@
 #include <thread>
 
 #include "lumar/base/error.h"
-#include "lumar/pipeline/stop_signal.h"
+#include "lumar/base/stop_signal.h"
 
 namespace lumar::pipeline {
 

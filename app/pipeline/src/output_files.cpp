@@ -1,6 +1,10 @@
 #include "lumar/pipeline/output_files.h"
 
 #include <fmt/format.h>
+
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
@@ -20,6 +24,12 @@ fs::path checked_video_path(fs::path path) {
 }  // namespace
 
 VideoOutput::VideoOutput(fs::path path, double fps, cv::Size size) : file_(checked_video_path(std::move(path))) {
+  // The encoder says only that it failed; creating the file first says why (a read-only
+  // folder, no permission).
+  if (std::FILE* probe = std::fopen(file_.temporary().c_str(), "wb"))
+    std::fclose(probe);
+  else
+    throw RuntimeError(file_.path().string() + ": cannot create the video: " + std::strerror(errno));
   // H.264 where the FFmpeg build has an encoder for it, else MPEG-4 part 2. The
   // temporary keeps the extension, so FFmpeg picks the same container.
   for (const char* fourcc : {"avc1", "mp4v"}) {
@@ -35,10 +45,24 @@ VideoOutput::VideoOutput(fs::path path, double fps, cv::Size size) : file_(check
 
 VideoOutput::~VideoOutput() { writer_.release(); }
 
-void VideoOutput::write(const cv::Mat& bgr8) { writer_.write(bgr8); }
+void VideoOutput::write(const cv::Mat& bgr8) {
+  writer_.write(bgr8);
+  ++frames_;
+}
 
 void VideoOutput::commit() {
   writer_.release();
+  // OpenCV's writer reports no write error: a full disk leaves a cut file that no player
+  // opens. So the video is read back before it takes its final name.
+  if (frames_ > 0) {
+    cv::VideoCapture check(file_.temporary().string(), cv::CAP_FFMPEG);
+    const auto held = check.isOpened() ? std::int64_t(check.get(cv::CAP_PROP_FRAME_COUNT)) : 0;
+    if (held < frames_)
+      throw RuntimeError(
+          fmt::format("{}: the video could not be written whole (is the disk full?): it holds {} of {} "
+                      "frames",
+                      file_.path().string(), held, frames_));
+  }
   file_.commit();
 }
 
@@ -46,8 +70,16 @@ FramesOutput::FramesOutput(fs::path dir) : folder_(std::move(dir)) {}
 
 void FramesOutput::write(std::int64_t index, const cv::Mat& bgr8) {
   const fs::path file = folder_.temporary() / fmt::format("frame-{:06d}.png", index);
-  if (!cv::imwrite(file.string(), bgr8))
-    throw RuntimeError((folder_.path() / file.filename()).string() + ": cannot write PNG");
+  // Encoded in memory and written here, so that a failed write (a full disk) is one
+  // error of ours with its reason, not libpng's message on stderr besides.
+  std::vector<uchar> png;
+  if (!cv::imencode(".png", bgr8, png)) throw RuntimeError("cannot encode frame " + std::to_string(index) + " as PNG");
+  std::FILE* out = std::fopen(file.c_str(), "wb");
+  int error = out ? 0 : errno;
+  if (out && std::fwrite(png.data(), 1, png.size(), out) != png.size()) error = errno;
+  if (out && std::fclose(out) != 0 && error == 0) error = errno;  // buffered bytes fail here
+  if (error != 0)
+    throw RuntimeError((folder_.path() / file.filename()).string() + ": cannot write PNG: " + std::strerror(error));
 }
 
 void FramesOutput::commit() { folder_.commit(); }

@@ -1,5 +1,6 @@
 #include "lumar/sim/synthetic_recording.h"
 
+#include <fmt/format.h>
 #include <spdlog/spdlog.h>
 #include <cmath>
 #include <opencv2/calib3d.hpp>
@@ -7,6 +8,7 @@
 
 #include "lumar/base/color.h"
 #include "lumar/base/error.h"
+#include "lumar/base/stop_signal.h"
 #include "lumar/calib/undistortion.h"
 #include "lumar/capture/recording_writer.h"
 #include "lumar/capture/session.h"
@@ -62,6 +64,9 @@ void write_synthetic_recording(const std::filesystem::path& out, const capture::
     write_tracker_stream(writer, tracker, session.tracker, session.rig.latency);
     cv::RNG rng(seed);
     for (int k = 0; k < frames; ++k) {
+      if (stop_requested())
+        throw Interrupted(
+            fmt::format("synth: at frame {} of {}; {} removed, as an unfinished recording", k, frames, out.string()));
       const Nanos t = frame_time(k);
       const Pose T_world_camera = true_camera(t);
       writer.add_frame(capture::Frame{render(k, t, T_world_camera, rng), t, k});

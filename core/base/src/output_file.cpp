@@ -123,4 +123,15 @@ void write_file_atomically(const fs::path& path, std::string_view contents) {
   out.commit();
 }
 
+void refuse_output_over_input(const std::filesystem::path& output, const std::vector<std::filesystem::path>& inputs,
+                              const std::string& option) {
+  std::error_code ec;
+  if (output.empty() || !std::filesystem::exists(output, ec)) return;
+  for (const auto& input : inputs) {
+    if (std::filesystem::equivalent(output, input, ec))
+      throw InputError(option + " " + output.string() + " is an input (" + input.string() +
+                       "); write the output to another file");
+  }
+}
+
 }  // namespace lumar

@@ -10,6 +10,7 @@
 
 #include "decode_counter.h"
 #include "lumar/base/error.h"
+#include "ply_size_check.h"
 
 namespace lumar {
 
@@ -51,6 +52,7 @@ std::pair<glm::vec3, glm::vec3> Mesh::bounds() const {
 Mesh load_mesh(const std::filesystem::path& path) {
   const std::string name = path.string();
   if (!std::filesystem::is_regular_file(path)) throw InputError(name + ": mesh file not found; check the path");
+  check_ply_sizes(path);
 
   // Pre-transforming bakes the node hierarchy's transforms into the vertices, so a glTF
   // or OBJ whose parts are placed by nodes loads where its author put it. Normals are

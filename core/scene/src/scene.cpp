@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "lumar/base/error.h"
+#include "lumar/base/json_file.h"
 #include "lumar/base/pose.h"
 
 namespace lumar {
@@ -74,6 +75,28 @@ class ManifestReader {
     return out;
   }
 
+  // A position in metres: within kMaxCoordinateM of the origin on each axis, so that
+  // rays and matrices built from it stay far from float overflow (docs/formats.md).
+  glm::dvec3 position(const json& v, const std::string& key) const {
+    const glm::dvec3 p = vec3(v, key);
+    for (int i = 0; i < 3; ++i)
+      if (std::abs(p[i]) > kMaxCoordinateM)
+        fail(key, "expected coordinates within ±" + std::to_string(int(kMaxCoordinateM)) + " m of the origin");
+    return p;
+  }
+
+  glm::dvec3 position_or(const json& parent, const std::string& parent_key, const char* name,
+                         glm::dvec3 fallback) const {
+    return parent.contains(name) ? position(parent.at(name), join(parent_key, name)) : fallback;
+  }
+
+  // A scale factor from model units to metres, within kMinScale..kMaxScale.
+  double scale_or(const json& parent, const std::string& parent_key, const char* name) const {
+    const double s = number_or(parent, parent_key, name, 1.0);
+    if (!(s >= kMinScale && s <= kMaxScale)) fail(join(parent_key, name), "expected a number from 1e-6 to 1e6");
+    return s;
+  }
+
   glm::dvec3 vec3_or(const json& parent, const std::string& parent_key, const char* name, glm::dvec3 fallback) const {
     return parent.contains(name) ? vec3(parent.at(name), join(parent_key, name)) : fallback;
   }
@@ -112,23 +135,7 @@ std::string fmt_number(double v) {
   return s.str();
 }
 
-json parse_manifest(const std::filesystem::path& manifest) {
-  const std::string name = manifest.string();
-  if (!std::filesystem::is_regular_file(manifest))
-    throw InputError(name + ": scene manifest not found; check the path");
-  std::ifstream file(manifest, std::ios::binary);
-  if (!file) throw InputError(name + ": cannot open the scene manifest for reading");
-  std::stringstream text;
-  text << file.rdbuf();
-  try {
-    return json::parse(text.str());
-  } catch (const json::parse_error& e) {
-    // e.what() starts with "[json.exception.parse_error.101] "; the rest says where.
-    std::string why = e.what();
-    if (const auto p = why.find("] "); p != std::string::npos) why = why.substr(p + 2);
-    throw InputError(name + ": malformed JSON: " + why);
-  }
-}
+json parse_manifest(const std::filesystem::path& manifest) { return read_json_file(manifest, "scene manifest"); }
 
 // "pose": translation, one of rotation_axis + rotation_deg | yaw_pitch_roll_deg |
 // rotation_wxyz, scale, model_origin ([x, y, z] or "bottom-centre"), on_floor.
@@ -137,7 +144,7 @@ ObjectPose read_pose(const ManifestReader& r, const json& pose, const std::strin
               {"translation", "rotation_axis", "rotation_deg", "yaw_pitch_roll_deg", "rotation_wxyz", "scale",
                "model_origin", "on_floor"});
   ObjectPose p;
-  p.translation = r.vec3_or(pose, pk, "translation", p.translation);
+  p.translation = r.position_or(pose, pk, "translation", p.translation);
   const bool axis_angle = pose.contains("rotation_axis") || pose.contains("rotation_deg");
   const int forms = int(axis_angle) + int(pose.contains("yaw_pitch_roll_deg")) + int(pose.contains("rotation_wxyz"));
   if (forms > 1) r.fail(pk, "give one rotation: rotation_axis and rotation_deg, yaw_pitch_roll_deg, or rotation_wxyz");
@@ -159,8 +166,7 @@ ObjectPose read_pose(const ManifestReader& r, const json& pose, const std::strin
     if (std::abs(glm::length(rotation) - 1.0) > 1e-3) r.fail(pk + ".rotation_wxyz", what);
     p.rotation = glm::normalize(rotation);
   }
-  p.scale = r.number_or(pose, pk, "scale", 1.0);
-  if (!(p.scale > 0.0)) r.fail(pk + ".scale", "must be positive");
+  p.scale = r.scale_or(pose, pk, "scale");
   if (pose.contains("model_origin")) {
     const json& origin = pose.at("model_origin");
     if (origin.is_string()) {
@@ -169,6 +175,9 @@ ObjectPose read_pose(const ManifestReader& r, const json& pose, const std::strin
       p.model_origin = std::nullopt;
     } else {
       p.model_origin = r.vec3(origin, pk + ".model_origin", "expected [x, y, z] or \"bottom-centre\"");
+      // Model units: in metres it is scale times this.
+      if (glm::length(*p.model_origin) * p.scale > kMaxCoordinateM)
+        r.fail(pk + ".model_origin", "lies more than 10 km from the model's origin once scaled");
     }
   }
   p.on_floor = r.boolean_or(pose, pk, "on_floor", false);
@@ -296,7 +305,7 @@ Scene load_scene(const std::filesystem::path& manifest) {
   // A distant map is at infinity, so where it was captured does not matter.
   if (!scene.distant_map && !env.contains("capture_position"))
     r.fail("environment_map.capture_position", "missing (required unless \"distant\": true)");
-  scene.capture_position = r.vec3_or(env, "environment_map", "capture_position", glm::dvec3(0.0));
+  scene.capture_position = r.position_or(env, "environment_map", "capture_position", glm::dvec3(0.0));
 
   // The proxy room gives the map's parallax and the surfaces shadows fall on; only a
   // distant map can do without it.
@@ -304,8 +313,7 @@ Scene load_scene(const std::filesystem::path& manifest) {
     const json& room = r.object(doc, "", "room");
     r.only_keys(room, "room", {"mesh", "scale"});
     scene.room_mesh = r.existing_file(room, "room", "mesh");
-    scene.room_scale = r.number_or(room, "room", "scale", 1.0);
-    if (!(scene.room_scale > 0.0)) r.fail("room.scale", "must be positive");
+    scene.room_scale = r.scale_or(room, "room", "scale");
   } else if (!scene.distant_map) {
     r.fail("room", "missing (required unless environment_map.distant is true)");
   }
@@ -314,8 +322,8 @@ Scene load_scene(const std::filesystem::path& manifest) {
   r.only_keys(box, "movement_box", {"min", "max"});
   if (!box.contains("min")) r.fail("movement_box.min", "missing");
   if (!box.contains("max")) r.fail("movement_box.max", "missing");
-  scene.movement_min = r.vec3(box.at("min"), "movement_box.min");
-  scene.movement_max = r.vec3(box.at("max"), "movement_box.max");
+  scene.movement_min = r.position(box.at("min"), "movement_box.min");
+  scene.movement_max = r.position(box.at("max"), "movement_box.max");
   for (int i = 0; i < 3; ++i)
     if (scene.movement_min[i] > scene.movement_max[i]) r.fail("movement_box", "min must not exceed max on any axis");
 

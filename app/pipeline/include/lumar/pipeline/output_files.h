@@ -1,6 +1,7 @@
 #pragma once
 // The overlay's outputs, whole or not at all (lumar/base/output_file.h): a video, a
 // folder of PNG frames, a contact sheet.
+#include <cstdint>
 #include <filesystem>
 #include <opencv2/core.hpp>
 #include <opencv2/videoio.hpp>
@@ -13,6 +14,8 @@
 
 namespace lumar::pipeline {
 
+// RuntimeError (exit 1) when the video cannot be created, or when at commit() it does
+// not hold every frame written (a full disk): the final name is then never taken.
 class VideoOutput {
  public:
   VideoOutput(std::filesystem::path path, double fps, cv::Size size);
@@ -25,6 +28,7 @@ class VideoOutput {
   OutputFile file_;
   cv::VideoWriter writer_;
   std::string codec_;
+  std::int64_t frames_ = 0;
 };
 
 class FramesOutput {

@@ -9,7 +9,9 @@
 // Errors: InputError when the output's folder does not exist or the path is a folder;
 // RuntimeError, naming the final path, when writing, syncing or renaming fails.
 #include <filesystem>
+#include <string>
 #include <string_view>
+#include <vector>
 
 namespace lumar {
 
@@ -50,6 +52,12 @@ class OutputFolder {
 
 // `contents` into `path` through an OutputFile.
 void write_file_atomically(const std::filesystem::path& path, std::string_view contents);
+
+// InputError when `output` (given as `option`) is the same file as one of `inputs`
+// (std::filesystem::equivalent, so links and other spellings count), checked before
+// anything is written: an output is never allowed to replace what it is made from.
+void refuse_output_over_input(const std::filesystem::path& output, const std::vector<std::filesystem::path>& inputs,
+                              const std::string& option = "--out");
 
 // fsync(2) of a file or a folder (a folder must be synced to make a rename or a new
 // entry durable). RuntimeError naming it on failure.

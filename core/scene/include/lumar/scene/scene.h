@@ -12,6 +12,13 @@
 
 namespace lumar {
 
+// Ranges every manifest number is held to before it reaches Embree, OpenGL or an
+// allocator (docs/formats.md): positions in metres within ±10 km of the origin on each
+// axis, scale factors from 1e-6 to 1e6. Beyond them rays lose their float precision;
+// Embree aborted on a scale of 1e300 and on positions of 1e30.
+inline constexpr double kMaxCoordinateM = 1e4;
+inline constexpr double kMinScale = 1e-6, kMaxScale = 1e6;
+
 // Where an object stands (manifest key "pose", docs/formats.md). The rotation is given
 // as an axis and an angle, as yaw, pitch and roll, or as a quaternion.
 struct ObjectPose {

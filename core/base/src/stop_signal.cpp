@@ -1,8 +1,8 @@
-#include "lumar/pipeline/stop_signal.h"
+#include "lumar/base/stop_signal.h"
 
 #include <csignal>
 
-namespace lumar::pipeline {
+namespace lumar {
 
 namespace {
 volatile std::sig_atomic_t g_stop = 0;
@@ -19,4 +19,4 @@ void catch_stop_signals() {
 
 bool stop_requested() { return g_stop != 0; }
 
-}  // namespace lumar::pipeline
+}  // namespace lumar
