@@ -6,6 +6,8 @@
 #include <nlohmann/json.hpp>
 #include <opencv2/core/utility.hpp>
 
+#include <fmt/format.h>
+
 #include "commands.h"
 #include "lumar/base/error.h"
 #include "lumar/base/glob.h"
@@ -37,6 +39,21 @@ struct CalibrateOptions {
   double marker = 0.0;
   std::string dict = "DICT_5X5_100";
 };
+
+// The most squares a board may have along the image's longer and shorter sides: each
+// square must cover at least kMinSquarePx pixels, or the detector cannot find its corners
+// (and an absurd size such as 100000x100000 made it allocate for 45 s before bad_alloc).
+constexpr int kMinSquarePx = 5;
+
+void check_board_fits(const std::string& option, const std::string& text, cv::Size squares, cv::Size image) {
+  const int most_long = std::max(image.width, image.height) / kMinSquarePx;
+  const int most_short = std::min(image.width, image.height) / kMinSquarePx;
+  if (std::max(squares.width, squares.height) > most_long || std::min(squares.width, squares.height) > most_short)
+    throw InputError(fmt::format(
+        "{} {}: a board of {}x{} squares cannot be seen in a {}x{} image (at most {}x{} "
+        "squares of {} px); give the board's inner corners, e.g. 9x6",
+        option, text, squares.width, squares.height, image.width, image.height, most_long, most_short, kMinSquarePx));
+}
 
 cv::Size parse_board(const std::string& option, const std::string& text, const char* what) {
   int w = 0, h = 0;
@@ -116,6 +133,10 @@ void register_calibrate(CLI::App& app) {
     refuse_output_over_input(o->out, inputs);
     refuse_output_over_input(o->coverage, inputs, "--coverage");
     refuse_output_over_input(o->preview, inputs, "--preview");
+    // Outputs are checked before the work, so that a missing folder is known now, not
+    // after it: an OutputFile checks its path when it is made (and writes nothing).
+    for (const std::string& out : {o->out, o->coverage, o->preview})
+      if (!out.empty()) OutputFile{out};
     const std::vector<calib::NamedImage> images =
         o->source.empty() ? calib::load_board_images(inputs) : frames_from_source(*o);
     // Both boards give views for the same robust solve; the report names inner corners.
@@ -123,11 +144,13 @@ void register_calibrate(CLI::App& app) {
     cv::Size board;
     if (!o->charuco.empty()) {
       const cv::Size squares = parse_board("--charuco", o->charuco, "squares as WxH, e.g. 7x5");
+      if (!images.empty()) check_board_fits("--charuco", o->charuco, squares, images.front().image.size());
       if (!(o->marker > 0)) throw InputError("--charuco: give the marker side with --marker (metres)");
       views = calib::detect_charuco_views(images, {squares.width, squares.height, o->square, o->marker, o->dict});
       board = {squares.width - 1, squares.height - 1};
     } else {
       board = parse_board("--board", o->board, "inner corners as WxH, e.g. 9x6");
+      if (!images.empty()) check_board_fits("--board", o->board, board + cv::Size(1, 1), images.front().image.size());
       views = calib::detect_checkerboard_views(images, board, o->square);
     }
     auto options = o->calib;

@@ -127,6 +127,21 @@ case_output_over_an_input_image_is_refused() {
   [ ! -e "$TMP/c.yml" ] || fail "an output was written"
 }
 
+case_absurd_board_and_missing_folder_fail_at_once() {
+  # --board 100000x100000 ran 45 s into bad_alloc (exit 1); --out in a missing folder was
+  # found only after the calibration. Both are one line, exit 2, within a few seconds.
+  local start=$SECONDS
+  expect_bad_input "cannot be seen in a 640x480 image" "$TMP/cam.yml" -- \
+    "$LUMAR" calibrate --images "$BOARDS/*.jpg" --board 100000x100000 --out "$TMP/cam.yml"
+  expect_bad_input "cannot be seen" "$TMP/cam.yml" -- \
+    "$LUMAR" calibrate --images "$BOARDS/*.jpg" --board 200x5 --out "$TMP/cam.yml"
+  expect_bad_input "missing/c.yml" "" -- \
+    "$LUMAR" calibrate --images "$BOARDS/*.jpg" --out "$TMP/missing/c.yml"
+  expect_bad_input "missing/cov.png" "" -- \
+    "$LUMAR" calibrate --images "$BOARDS/*.jpg" --out "$TMP/c.yml" --coverage "$TMP/missing/cov.png"
+  [ $((SECONDS - start)) -lt 30 ] || fail "took $((SECONDS - start)) s"
+}
+
 case_unreadable_image() {
   printf 'not a jpeg' >"$TMP/broken.jpg"
   expect_bad_input "$TMP/broken.jpg" "$TMP/cam.yml" -- \
