@@ -109,10 +109,14 @@ Compared compare_live_with_replay(const std::filesystem::path& dir, int adapt_li
   return c;
 }
 
+constexpr int kFewestLiveFrames = 8;
+
 TEST(LiveOverlay, FramesMatchTheReplayOfTheSameInputs) {
   const Compared c = compare_live_with_replay(still_recording(), 0);
   std::printf("%d live frames with a pose, worst PSNR against the replay %.1f dB\n", c.frames, c.worst_psnr);
-  EXPECT_GE(c.frames, 12);
+  // A live source drops the frames the overlay is too slow for (36 of 48 at release speed,
+  // more under the sanitizers), so only a few compared frames are certain on any machine.
+  EXPECT_GE(c.frames, kFewestLiveFrames);
   EXPECT_GE(c.worst_psnr, 40.0);
 }
 
@@ -126,7 +130,7 @@ TEST(LiveOverlay, AdaptsTheLightingAsTheReplayDoes) {
   const Compared c = compare_live_with_replay(dir, 4);
   std::printf("%d frames; lighting scale live %.4f, replay %.4f; worst PSNR %.1f dB\n", c.frames, c.live_scale,
               c.replay_scale, c.worst_psnr);
-  EXPECT_GE(c.frames, 12);
+  EXPECT_GE(c.frames, kFewestLiveFrames);  // two lighting updates at least (every 4 frames)
   EXPECT_NEAR(c.replay_scale, 0.5, 0.05);
   EXPECT_NEAR(c.live_scale, c.replay_scale, 0.01);
   EXPECT_GE(c.worst_psnr, 35.0);
