@@ -21,7 +21,7 @@ namespace {
 struct OverlayOptions {
   std::string recording, scene, out, frames_dir, contact_sheet, poses = "tracker", undistort = "same";
   std::string filter = "none";
-  bool window = false, no_cache = false;
+  bool window = false, no_cache = false, allow_incomplete = false;
   int max_frames = 0;
   int adapt_lighting = 0;
   pipeline::LiveOverlayOptions live;  // --source and what only the live path reads
@@ -92,12 +92,14 @@ void run_replay(const OverlayOptions& o) {
   settings.scene = o.scene;
   settings.poses = o.poses == "truth" ? pipeline::PoseSource::Truth : pipeline::PoseSource::Tracker;
   settings.filter = tracking::parse_pose_filter(o.filter);
+  settings.allow_incomplete = o.allow_incomplete;
   settings.overlay = overlay_settings(o, o.window);
   pipeline::ReplayOverlay overlay(o.recording, settings);
   const auto& camera = overlay.compositor().output_camera();
   std::int64_t total = std::int64_t(overlay.replay().reader().frames().size());
   if (total == 0)  // an empty video would look like a result
     throw InputError(o.recording + ": has no frames to composite (frames.csv lists none)");
+  if (const auto& loss = overlay.replay().tracker_loss(); !loss.empty()) spdlog::warn("{}", loss);
   if (o.max_frames > 0) total = std::min<std::int64_t>(total, o.max_frames);
   catch_stop_signals();  // from here on Ctrl-C stops between frames, and nothing is committed
   pipeline::OverlayOutputs outputs({o.out, o.frames_dir, o.contact_sheet, overlay.replay().reader().video().fps,
@@ -115,8 +117,8 @@ void run_replay(const OverlayOptions& o) {
     throw Interrupted(fmt::format("overlay: after {} of {} frames; no output written", done, total));
   outputs.commit();
   const auto& stats = overlay.replay().tracker_stats();
-  spdlog::info("overlay: {} frames{}; tracker: {} records, {} rejected, {} bytes skipped", overlay.times().frames,
-               outputs.describe(), stats.records, stats.rejected_records, stats.skipped_bytes);
+  spdlog::info("overlay: {} frames{}; tracker: {} records, {} rejected, {} of {} bytes lost", overlay.times().frames,
+               outputs.describe(), stats.records, stats.rejected_records, stats.lost_bytes(), stats.stream_bytes);
   report(overlay.overlay());
 }
 
@@ -151,6 +153,8 @@ void register_overlay(CLI::App& app) {
       ->capture_default_str();
   cmd->add_flag("--window", o->window,
                 "Show the result in a window (needs a display); the live path shows one unless it writes files");
+  cmd->add_flag("--allow-incomplete", o->allow_incomplete,
+                "Replay a recording that was never closed (killed or crashed): its closed frames");
   cmd->add_option("--max-frames", o->max_frames, "Stop after this many frames (0 = all)")->capture_default_str();
   cmd->add_flag("--no-cache", o->no_cache,
                 "Build the irradiance volume without reading or writing the cache ($XDG_CACHE_HOME/lumar)");

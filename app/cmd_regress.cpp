@@ -27,7 +27,7 @@ struct RegressOptions {
   std::vector<std::string> recordings;
   std::string root = "recordings";
   std::string scene;  // instead of the one the session names (a live recording names none)
-  bool update = false, no_cache = false;
+  bool update = false, no_cache = false, allow_incomplete = false;
 };
 
 const cv::Size kGoldenSize(160, 120);
@@ -92,10 +92,15 @@ Outcome regress_one(const fs::path& dir, const RegressOptions& o) {
   pipeline::ReplayOverlaySettings settings;
   settings.scene = o.scene;
   settings.overlay.volume_cache = !o.no_cache;
+  settings.allow_incomplete = o.allow_incomplete;
   pipeline::ReplayOverlay overlay(dir, settings);
   const auto& frames = overlay.replay().reader().frames();
   if (frames.empty()) throw InputError(dir.string() + ": recording holds no frames");
   if (overlay.replay().reader().truth().empty()) throw InputError(dir.string() + ": regression needs truth.csv");
+  if (const auto& t = overlay.replay().tracker_stats(); t.stream_bytes > 0 && t.records == 0)
+    throw InputError((dir / "tracker.raw").string() + ": no tracker record in its " + std::to_string(t.stream_bytes) +
+                     " bytes; the stream is damaged, or session.json's tracker settings are not the device's");
+  if (const auto& loss = overlay.replay().tracker_loss(); !loss.empty()) spdlog::warn("{}", loss);
   if (update) {
     const std::int64_t last = frames.back().index;
     golden = {0, last / 3, 2 * last / 3, last};
@@ -196,6 +201,8 @@ void register_regress(CLI::App& app) {
   cmd->add_option("recordings", o->recordings, "Recording directories (default: every one under --root)");
   cmd->add_option("--root", o->root, "Folder of recordings")->capture_default_str();
   cmd->add_option("--scene", o->scene, "Scene manifest for every recording (default: the one its session names)");
+  cmd->add_flag("--allow-incomplete", o->allow_incomplete,
+                "Accept recordings that were never closed (killed or crashed)");
   cmd->add_flag("--no-cache", o->no_cache, "Build the irradiance volume without reading or writing the cache");
   cmd->add_flag("--update", o->update,
                 "Write new golden frames and expected.json instead of comparing (thresholds: docs/formats.md, "

@@ -1,9 +1,12 @@
 // lumar: the command line. Each subcommand lives in its own file (cmd_*.cpp) and
 // registers itself through register_*(); errors become one line and an exit status.
+#include <spdlog/sinks/base_sink.h>
 #include <spdlog/spdlog.h>
 #include <CLI/CLI.hpp>
 #include <cstdio>
 #include <cstdlib>
+#include <memory>
+#include <mutex>
 
 #include "commands.h"
 #include "lumar/base/error.h"
@@ -15,6 +18,28 @@
 // calling thread and checks Lumar's own threads (capture, tracker, live pipelines).
 static const tbb::global_control tsan_serial_tbb(tbb::global_control::max_allowed_parallelism, 1);
 #endif
+
+namespace {
+
+// What a command did goes to stdout; warnings and debug detail go to stderr, where
+// scripts and people look for trouble. Each line is flushed, so the two stay in order
+// on a terminal.
+class SplitSink : public spdlog::sinks::base_sink<std::mutex> {
+ protected:
+  void sink_it_(const spdlog::details::log_msg& msg) override {
+    spdlog::memory_buf_t text;
+    formatter_->format(msg, text);
+    std::FILE* out = msg.level == spdlog::level::info ? stdout : stderr;
+    std::fwrite(text.data(), 1, text.size(), out);
+    std::fflush(out);
+  }
+  void flush_() override {
+    std::fflush(stdout);
+    std::fflush(stderr);
+  }
+};
+
+}  // namespace
 
 int main(int argc, char** argv) {
   // FFmpeg's own log lines (e.g. "overread 8" on a damaged segment) would break the
@@ -31,6 +56,7 @@ int main(int argc, char** argv) {
   } catch (const CLI::ParseError& e) {
     return app.exit(e) == 0 ? 0 : 2;
   }
+  spdlog::set_default_logger(std::make_shared<spdlog::logger>("lumar", std::make_shared<SplitSink>()));
   spdlog::set_level(verbose ? spdlog::level::debug : spdlog::level::info);
   spdlog::set_pattern("%v");
   try {

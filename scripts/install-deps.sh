@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Installs every Debian 12 package Lumar needs to build, run and test.
 # Safe to re-run: packages already present are skipped by apt-get.
+# Usage: scripts/install-deps.sh [--fuzz]   (--fuzz: also clang and libFuzzer, for scripts/fuzz.sh)
 set -euo pipefail
 
 packages=(
@@ -20,6 +21,11 @@ packages=(
   xvfb xauth                         # window tests under xvfb-run
   python3                            # JSON checks in the command-line tests
 )
+case "${1:-}" in
+  "") ;;
+  --fuzz) packages+=(clang-14 libclang-rt-14-dev) ;;  # libFuzzer, ASan and UBSan runtimes
+  *) echo "install-deps: unknown argument '$1'; usage: scripts/install-deps.sh [--fuzz]" >&2; exit 2 ;;
+esac
 
 missing=()
 for p in "${packages[@]}"; do

@@ -3,6 +3,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "lumar/base/error.h"
+#include "lumar/base/input_file.h"
 
 namespace lumar::calib {
 
@@ -10,8 +11,8 @@ std::vector<NamedImage> load_board_images(const std::vector<std::filesystem::pat
   std::vector<NamedImage> images;
   for (const auto& path : paths) {
     const std::string name = path.string();
-    if (!std::filesystem::is_regular_file(path))
-      throw InputError(name + ": image not found; check the path or remove it from the list");
+    if (const auto problem = input_file_problem(path))
+      throw InputError(name + ": image " + *problem + "; check the path or remove it from the list");
     cv::Mat grey = cv::imread(name, cv::IMREAD_GRAYSCALE);
     if (grey.empty())
       throw InputError(name + ": cannot read image (missing or not an image file); remove it from the list");

@@ -4,6 +4,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "lumar/base/error.h"
+#include "lumar/base/stop_signal.h"
 
 namespace lumar::calib {
 
@@ -83,6 +84,7 @@ BoardViews detect_charuco_views(const std::vector<NamedImage>& images, const Cha
   BoardViews views;
   views.image_size = images.front().image.size();
   for (const auto& named : images) {
+    throw_if_stopped("calibrate: while looking for the board in " + named.name);
     if (named.image.size() != views.image_size)
       throw InputError(named.name + ": image size differs from " + images.front().name +
                        "; calibrate one camera mode at a time");

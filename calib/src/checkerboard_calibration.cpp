@@ -6,6 +6,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "lumar/base/error.h"
+#include "lumar/base/stop_signal.h"
 
 namespace lumar::calib {
 
@@ -56,6 +57,7 @@ BoardViews detect_checkerboard_views(const std::vector<NamedImage>& images, cv::
   std::vector<std::string> checked_names;
   result.image_size = images.front().image.size();
   for (const auto& named : images) {
+    throw_if_stopped("calibrate: while looking for the board in " + named.name);
     if (named.image.size() != result.image_size)
       throw InputError(named.name + ": image is " + size_text(named.image.size()) + " but " + images.front().name +
                        " is " + size_text(result.image_size) + "; calibrate one camera mode at a time");

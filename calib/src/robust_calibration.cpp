@@ -8,6 +8,7 @@
 #include <random>
 
 #include "lumar/base/error.h"
+#include "lumar/base/stop_signal.h"
 
 namespace lumar::calib {
 
@@ -132,6 +133,7 @@ RobustCalibrationResult calibrate_robust(const BoardViews& views, const RobustCa
     const auto worst = std::max_element(s.per_view_rms.begin(), s.per_view_rms.end());
     if (*worst <= threshold) break;
     const std::size_t k = std::size_t(worst - s.per_view_rms.begin());
+    throw_if_stopped("calibrate: while rejecting outlier views");
     result.rejected.push_back({views.names[kept[k]], *worst, threshold, round});
     kept.erase(kept.begin() + std::ptrdiff_t(k));
     s = solve(views, kept, o);
@@ -149,6 +151,7 @@ RobustCalibrationResult calibrate_robust(const BoardViews& views, const RobustCa
     std::mt19937 rng(o.seed);
     double holdout = 0, training = 0;
     for (int split = 0; split < o.holdout_splits; ++split) {
+      throw_if_stopped("calibrate: while cross-validating");
       std::vector<int> order = kept;
       std::shuffle(order.begin(), order.end(), rng);
       const std::vector<int> train(order.begin(), order.begin() + m / 2);

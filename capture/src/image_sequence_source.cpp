@@ -7,9 +7,10 @@
 #include <opencv2/imgproc.hpp>
 #include <set>
 
-#include "csv_text.h"
+#include "lumar/base/csv.h"
 #include "lumar/base/error.h"
 #include "lumar/base/glob.h"
+#include "lumar/base/input_file.h"
 
 namespace lumar::capture {
 namespace fs = std::filesystem;
@@ -62,35 +63,17 @@ ImageSequenceSource::ImageSequenceSource(ImageSequenceSettings settings) : setti
   } else {
     const fs::path& table = settings_.timestamps;
     const fs::path folder = image_folder(pattern);
-    const std::string text = csv::read_file(table);
-    std::size_t line = 0, at = 0;
-    while (at < text.size()) {
-      const std::size_t end = text.find('\n', at);
-      if (end == std::string::npos) break;  // a torn last line: ignored, as in recordings
-      const std::string row = text.substr(at, end - at);
-      at = end + 1;
-      ++line;
-      const std::string where = table.string() + ":" + std::to_string(line) + ": ";
-      if (line == 1) {
-        if (row != "file,time_ns") throw InputError(where + "header must be 'file,time_ns'");
-        continue;
-      }
-      if (row.empty()) continue;
-      const std::size_t comma = row.rfind(',');
-      if (comma == std::string::npos || comma == 0) throw InputError(where + "expected file,time_ns");
-      Nanos t = 0;
-      const char* first = row.data() + comma + 1;
-      const char* last = row.data() + row.size();
-      auto [ptr, ec] = std::from_chars(first, last, t);
-      if (ec != std::errc() || ptr != last || first == last)
-        throw InputError(where + "time_ns '" + row.substr(comma + 1) + "' is not an integer");
-      if (!times_.empty() && t <= times_.back())
-        throw InputError(where + "time " + std::to_string(t) + " does not increase; the rows must be in time order");
-      const fs::path file = folder / row.substr(0, comma);
-      if (std::error_code e; !fs::is_regular_file(file, e)) throw InputError(where + "no such image " + file.string());
-      files_.push_back(file);
-      times_.push_back(t);
-    }
+    csv::for_each_row(table, read_input_file(table, "timestamp table"), {{"file", "time_ns"}},
+                      csv::LastLine::kIgnoreTorn, [&](const csv::Row& row) {
+                        const Nanos t = row.integer("time_ns");
+                        if (!times_.empty() && t <= times_.back())
+                          row.fail("time " + std::to_string(t) + " does not increase; the rows must be in time order");
+                        const fs::path file = folder / std::string(row.text("file"));
+                        if (auto problem = input_file_problem(file))
+                          row.fail("image " + file.string() + " " + *problem);
+                        files_.push_back(file);
+                        times_.push_back(t);
+                      });
     if (files_.empty()) throw InputError(table.string() + ": the timestamp table lists no frames");
     if (times_.size() > 1) fps_ = double(times_.size() - 1) / nanos_to_seconds(times_.back() - times_.front());
   }

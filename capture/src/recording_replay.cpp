@@ -1,5 +1,7 @@
 #include "lumar/capture/recording_replay.h"
 
+#include <fmt/format.h>
+
 #include "lumar/base/error.h"
 #include "lumar/tracking/tracker_stream.h"
 
@@ -8,10 +10,18 @@ namespace lumar::capture {
 RecordingReplay::RecordingReplay(const std::filesystem::path& dir,
                                  const std::optional<tracking::PoseFilterSettings>& filter)
     : reader_(dir), session_(reader_.session()) {
+  // Intrinsics of another size would project every pose to the wrong pixels.
+  const cv::Size video = reader_.video().size;
+  if (session_.camera.width != video.width || session_.camera.height != video.height)
+    throw InputError((dir / kSessionFile).string() + ": the camera is " + std::to_string(session_.camera.width) + "x" +
+                     std::to_string(session_.camera.height) + " but the video is " + std::to_string(video.width) + "x" +
+                     std::to_string(video.height) + "; give the calibration of the camera that recorded it");
   const TrackerSettings& t = session_.tracker;
-  const auto decoded = tracking::decode_tracker_stream(reader_.tracker_chunks(&stats_.torn_bytes),
-                                                       tracker_format_of(t, (dir / kSessionFile).string()), t.baud,
-                                                       session_.rig.latency);
+  std::size_t ignored = 0;
+  const auto chunks = reader_.tracker_chunks(&ignored, &stats_.torn_bytes);
+  stats_.damaged_bytes = ignored - stats_.torn_bytes;
+  const auto decoded = tracking::decode_tracker_stream(chunks, tracker_format_of(t, (dir / kSessionFile).string()),
+                                                       t.baud, session_.rig.latency);
   std::optional<tracking::PoseSampleFilter> filtered;
   if (filter) filtered.emplace(*filter);
   for (const auto& sample : decoded.samples)
@@ -19,6 +29,15 @@ RecordingReplay::RecordingReplay(const std::filesystem::path& dir,
   stats_.records = decoded.records;
   stats_.rejected_records = decoded.rejected_records;
   stats_.skipped_bytes = decoded.skipped_bytes;
+  std::error_code ec;
+  stats_.stream_bytes = std::size_t(std::filesystem::file_size(dir / kTrackerFile, ec));
+  if (ec) stats_.stream_bytes = 0;
+  if (stats_.lost_fraction() > kTrackerLossWarning)
+    tracker_loss_ = fmt::format(
+        "{}: {} of {} bytes ({:.1f} %) of the tracker stream lost: {} in damaged chunks, {} the {} parser skipped "
+        "({} records rejected); {} records read. Poses are missing where the bytes were",
+        (dir / kTrackerFile).string(), stats_.lost_bytes(), stats_.stream_bytes, 100.0 * stats_.lost_fraction(),
+        stats_.damaged_bytes, stats_.skipped_bytes, t.device, stats_.rejected_records, stats_.records);
   truth_ = reader_.truth();
 }
 

@@ -13,7 +13,7 @@
 #include <thread>
 #include <vector>
 
-#include "csv_text.h"
+#include "lumar/base/csv.h"
 #include "lumar/base/error.h"
 #include "lumar/base/output_file.h"
 #include "lumar/capture/append_file.h"
@@ -79,6 +79,8 @@ struct RecordingWriter::Impl {
   std::vector<FrameEntry> segment_rows;
   AppendFile frames_csv;
   std::atomic<std::int64_t> frames_written{0};
+  std::int64_t frames_added = 0, last_index = 0;  // under video_mutex
+  Nanos last_time = 0;
 
   SyncedLog tracker, poses, truth;
 
@@ -99,12 +101,14 @@ struct RecordingWriter::Impl {
     if (!first_error) first_error = e;
     failed = true;
   }
+  std::atomic<bool> error_told{false};  // a caller was thrown the failure
 
   // Throws when closed, or when an earlier write failed (the data would be lost).
   void check_usable() {
     if (closed) throw RuntimeError(what() + ": already closed; data added after close() is lost");
     if (failed) {
       std::lock_guard lock(state_mutex);
+      error_told = true;
       std::rethrow_exception(first_error);
     }
   }
@@ -209,6 +213,7 @@ struct RecordingWriter::Impl {
       throw;  // the caller's mistake; the recording is still fine
     } catch (...) {
       record_failure(std::current_exception());
+      error_told = true;
       throw;
     }
   }
@@ -276,12 +281,14 @@ RecordingWriter::RecordingWriter(const fs::path& dir, nlohmann::json session, Re
 
 RecordingWriter::~RecordingWriter() {
   if (!impl_) return;
+  // A failure a caller was already thrown (a full disk in add_frame) is not said twice.
+  const bool already_failed = impl_->error_told;
   try {
     close();
   } catch (const std::exception& e) {
-    spdlog::error("{}", e.what());
+    if (!already_failed) spdlog::error("{}", e.what());
   } catch (...) {
-    spdlog::error("{}: closing failed", impl_->what());
+    if (!already_failed) spdlog::error("{}: closing failed", impl_->what());
   }
   if (impl_->flusher.joinable()) impl_->flusher.join();
 }
@@ -297,6 +304,17 @@ void RecordingWriter::add_frame(const Frame& frame) {
                      std::to_string(w.settings.size.height));
   std::lock_guard lock(w.video_mutex);
   if (w.closed) throw RuntimeError(w.what() + ": already closed; frames added after close() are lost");
+  // The reader holds frames.csv to this (a file out of order is a damaged one).
+  if (frame.index < 0 || frame.time < 0)
+    throw InputError(w.what() + ": frame " + std::to_string(frame.index) + " at " + std::to_string(frame.time) +
+                     " ns: indices and times count from 0");
+  if (w.frames_added > 0 && (frame.index <= w.last_index || frame.time <= w.last_time))
+    throw InputError(w.what() + ": frame " + std::to_string(frame.index) + " at " + std::to_string(frame.time) +
+                     " ns comes after frame " + std::to_string(w.last_index) + " at " + std::to_string(w.last_time) +
+                     " ns; a source's frame numbers and times must increase");
+  w.last_index = frame.index;
+  w.last_time = frame.time;
+  ++w.frames_added;
   w.guarded([&] {
     if (!w.segment_open) w.open_segment();
     w.segment.write(img);

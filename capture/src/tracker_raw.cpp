@@ -47,23 +47,39 @@ void append_tracker_chunk(std::string& out, const tracking::ByteChunk& chunk) {
   out.append(reinterpret_cast<const char*>(chunk.bytes.data()), chunk.bytes.size());
 }
 
-std::vector<tracking::ByteChunk> parse_tracker_chunks(std::string_view data, std::size_t* ignored_bytes) {
+std::vector<tracking::ByteChunk> parse_tracker_chunks(std::string_view data, std::size_t* ignored_bytes,
+                                                      std::size_t* torn_tail_bytes) {
   std::vector<tracking::ByteChunk> chunks;
   const auto* p = reinterpret_cast<const unsigned char*>(data.data());
-  std::size_t pos = 0;
+  const std::string_view magic("LTRK", 4);
+  std::size_t pos = 0, good = 0, end_of_good = 0;
   while (data.size() - pos >= kTrackerChunkHeaderBytes) {
     const unsigned char* h = p + pos;
-    if (get_le(h, 4) != kTrackerChunkMagic) break;
     const auto arrival = Nanos(get_le(h + 4, 8));
     const std::size_t length = get_le(h + 12, 4);
     const auto crc = std::uint32_t(get_le(h + 16, 4));
-    if (data.size() - pos - kTrackerChunkHeaderBytes < length) break;
     const unsigned char* payload = h + kTrackerChunkHeaderBytes;
-    if (crc_of(payload, length) != crc) break;
-    chunks.push_back({arrival, std::vector<std::uint8_t>(payload, payload + length)});
-    pos += kTrackerChunkHeaderBytes + length;
+    if (get_le(h, 4) == kTrackerChunkMagic && data.size() - pos - kTrackerChunkHeaderBytes >= length &&
+        crc_of(payload, length) == crc) {
+      chunks.push_back({arrival, std::vector<std::uint8_t>(payload, payload + length)});
+      pos += kTrackerChunkHeaderBytes + length;
+      good += kTrackerChunkHeaderBytes + length;
+      end_of_good = pos;
+      continue;
+    }
+    // A damaged chunk: go on from the next magic, so that one bad length or flipped bit
+    // loses one chunk and not the rest of the recording. The CRC rejects a false magic.
+    const std::size_t next = data.find(magic, pos + 1);
+    if (next == std::string_view::npos) break;
+    pos = next;
   }
-  if (ignored_bytes) *ignored_bytes = data.size() - pos;
+  if (ignored_bytes) *ignored_bytes = data.size() - good;
+  if (torn_tail_bytes) {
+    // What follows the last whole chunk is a write cut short when it is the start of one.
+    const std::string_view tail = data.substr(end_of_good);
+    const bool starts_a_chunk = tail.substr(0, 4) == magic.substr(0, std::min<std::size_t>(4, tail.size()));
+    *torn_tail_bytes = starts_a_chunk && data.find(magic, end_of_good + 1) == std::string_view::npos ? tail.size() : 0;
+  }
   return chunks;
 }
 

@@ -141,7 +141,7 @@ TEST(ImageSequenceSource, BadInputIsOneLineNamingTheFile) {
   EXPECT_THAT(input_error_message([&] {
                 ImageSequenceSource({s.dir.string(), table, 0});
               }),
-              HasSubstr("times.csv:3: no such image"));
+              HasSubstr("times.csv:3: image"));
   write_table(table, {"frame-1.png,100", "frame-2.png,100"});
   EXPECT_THAT(input_error_message([&] {
                 ImageSequenceSource({s.dir.string(), table, 0});

@@ -83,12 +83,11 @@ TEST(TornTrackerLog, ChunksBeforeTheTearAreKeptAndTheRestCounted) {
   expect_prefix(2, 20);
 }
 
-TEST(TornTrackerLog, BadMagicOrCrcStopsTheReader) {
+TEST(DamagedTrackerLog, ABadChunkIsSkippedAndTheChunksAfterItAreKept) {
   const fs::path dir = test::scratch_dir("bad-tracker") / "rec";
   const test::RemoveOnSuccess cleanup{dir.parent_path()};
   const auto chunks = write_chunks(dir);
   const fs::path raw = dir / "tracker.raw";
-  const auto size = fs::file_size(raw);
   const std::uintmax_t chunk2 = 2 * kTrackerChunkHeaderBytes + 10 + 0;
 
   auto flip_byte = [&](std::uintmax_t offset) {
@@ -100,14 +99,47 @@ TEST(TornTrackerLog, BadMagicOrCrcStopsTheReader) {
   };
   const RecordingReader reader(dir);
   std::size_t ignored = 0;
+  const std::size_t chunk2_bytes = kTrackerChunkHeaderBytes + chunks[2].bytes.size();
+  auto expect_all_but_chunk2 = [&] {
+    const auto got = reader.tracker_chunks(&ignored);
+    ASSERT_EQ(got.size(), 4u);
+    EXPECT_EQ(got[1].bytes, chunks[1].bytes);
+    EXPECT_EQ(got[2].bytes, chunks[3].bytes);
+    EXPECT_EQ(ignored, chunk2_bytes);
+  };
   flip_byte(chunk2 + kTrackerChunkHeaderBytes + 5);  // payload byte: CRC mismatch
-  EXPECT_EQ(reader.tracker_chunks(&ignored).size(), 2u);
-  EXPECT_EQ(ignored, size - chunk2);
+  expect_all_but_chunk2();
   flip_byte(chunk2 + kTrackerChunkHeaderBytes + 5);  // repaired
   EXPECT_EQ(reader.tracker_chunks(&ignored).size(), 5u);
+  EXPECT_EQ(ignored, 0u);
   flip_byte(chunk2);  // magic
-  EXPECT_EQ(reader.tracker_chunks(&ignored).size(), 2u);
-  EXPECT_EQ(ignored, size - chunk2);
+  expect_all_but_chunk2();
+  flip_byte(chunk2);
+  flip_byte(chunk2 + 12 + 3);  // the length's top byte: it claims 1 GB more than the file holds
+  expect_all_but_chunk2();
+  flip_byte(chunk2 + 12 + 3);
+
+  // The first chunk's length corrupt (the case that lost every pose before): the rest is kept.
+  flip_byte(12 + 1);
+  EXPECT_EQ(reader.tracker_chunks(&ignored).size(), 4u);
+  EXPECT_EQ(ignored, kTrackerChunkHeaderBytes + chunks[0].bytes.size());
+  flip_byte(12 + 1);
+
+  // A torn last chunk (what a crash leaves) is told apart from damage.
+  std::size_t torn = 99;
+  fs::resize_file(raw, fs::file_size(raw) - 30);
+  EXPECT_EQ(reader.tracker_chunks(&ignored, &torn).size(), 4u);
+  EXPECT_EQ(torn, ignored);
+  EXPECT_EQ(torn, kTrackerChunkHeaderBytes + chunks[4].bytes.size() - 30);
+  flip_byte(chunk2 + kTrackerChunkHeaderBytes + 5);  // and damage before it
+  EXPECT_EQ(reader.tracker_chunks(&ignored, &torn).size(), 3u);
+  EXPECT_EQ(ignored - torn, chunk2_bytes);
+
+  // Nothing but garbage: no chunk, every byte ignored.
+  std::ofstream(raw, std::ios::binary | std::ios::trunc) << std::string(4096, 'x');
+  EXPECT_EQ(reader.tracker_chunks(&ignored, &torn).size(), 0u);
+  EXPECT_EQ(ignored, 4096u);
+  EXPECT_EQ(torn, 0u);
 }
 
 TEST(TornCsv, FinalPartialLineIsIgnoredButABadRowIsAnError) {
@@ -172,6 +204,32 @@ TEST(RecordingReaderErrors, NameTheFileThatIsWrong) {
   write_text(dir / "frames.csv", std::string(kFramesHeader) + "\n0,0,0,0\n0,1,0,2\n");
   EXPECT_THAT(test::input_error_message([&] { RecordingReader r(dir); }),
               HasSubstr("rec/frames.csv:3"));  // skips segment frame 1
+
+  // Times and indices must increase and times count from 0 (once accepted silently).
+  const std::string head = std::string(kFramesHeader) + "\n0,0,0,0\n";
+  write_text(dir / "frames.csv", head + "1,0,0,1\n");
+  EXPECT_THAT(test::input_error_message([&] { RecordingReader r(dir); }),
+              HasSubstr("rec/frames.csv:3: time_ns 0 does not increase"));
+  write_text(dir / "frames.csv", head + "2,-7,0,1\n");
+  EXPECT_THAT(test::input_error_message([&] { RecordingReader r(dir); }),
+              HasSubstr("rec/frames.csv:3: time_ns -7 is negative"));
+  write_text(dir / "frames.csv", std::string(kFramesHeader) + "\n0,50,0,0\n1,40,0,1\n");
+  EXPECT_THAT(test::input_error_message([&] { RecordingReader r(dir); }),
+              HasSubstr("rec/frames.csv:3: time_ns 40 does not increase"));
+  write_text(dir / "frames.csv", std::string(kFramesHeader) + "\n3,0,0,0\n3,10,0,1\n");
+  EXPECT_THAT(test::input_error_message([&] { RecordingReader r(dir); }),
+              HasSubstr("rec/frames.csv:3: index 3 does not increase"));
+  // Columns go by name: the same rows with the columns reordered read the same.
+  write_text(dir / "frames.csv", "time_ns,index,segment_frame,segment\n0,0,0,0\n5,1,1,0\n");
+  ASSERT_EQ(RecordingReader(dir).frames().size(), 2u);
+  EXPECT_EQ(RecordingReader(dir).frames()[1].time, 5);
+  EXPECT_EQ(RecordingReader(dir).frames()[1].segment_frame, 1);
+  write_text(dir / "frames.csv", "index,time,segment,segment_frame\n");
+  EXPECT_THAT(test::input_error_message([&] { RecordingReader r(dir); }),
+              HasSubstr("rec/frames.csv:1: the header has no column 'time_ns'"));
+  // An empty frames.csv (the writer died before its header) is a recording without frames.
+  write_text(dir / "frames.csv", "");
+  EXPECT_EQ(RecordingReader(dir).frames().size(), 0u);
 
   fs::remove(dir / "poses.csv");
   write_text(dir / "frames.csv", std::string(kFramesHeader) + "\n");

@@ -80,7 +80,7 @@ TEST(VideoFileSource, ReadsARecordingSegmentExactly) {
   settings.fps = 25;
   {
     RecordingWriter writer(dir, {}, settings);
-    for (int i = 0; i < 12; ++i) writer.add_frame({test::numbered_image(i, size), 0, i});
+    for (int i = 0; i < 12; ++i) writer.add_frame({test::numbered_image(i, size), i, i});
   }
   VideoFileSource source(RecordingReader(dir).segment_file(0));
   EXPECT_NEAR(source.nominal_fps(), 25.0, 1e-9);

@@ -168,4 +168,21 @@ case_frame_source_matches_images() {
   expect_bad_input "nowhere" "$TMP/c.yml" -- "$LUMAR" calibrate --source "nowhere:x" --out "$TMP/c.yml"
 }
 
+case_signals_stop_cleanly() {
+  # SIGINT and SIGTERM while it looks for boards in 78 photographs (each of the 13 six
+  # times): exit 130 within 2 s, no calibration file and no temporary; a later run works.
+  mkdir -p "$TMP/shots" "$TMP/out"
+  for k in 1 2 3 4 5 6; do
+    for f in "$SHARED"/data/calib/checkerboard-9x6/left*.jpg; do cp "$f" "$TMP/shots/$k-$(basename "$f")"; done
+  done
+  for signal in INT TERM; do
+    stop_midway "$signal" after:2 -- "$LUMAR" calibrate --images "$TMP/shots/*.jpg" --out "$TMP/out/c.yml" \
+      --coverage "$TMP/out/c.png"
+    [ -z "$(ls -A "$TMP/out")" ] || fail "left after SIG$signal: $(ls -A "$TMP/out")"
+  done
+  "$LUMAR" calibrate --images "$SHARED/data/calib/checkerboard-9x6/left0*.jpg" --out "$TMP/out/c.yml" \
+    >"$TMP/log" 2>&1 || { cat "$TMP/log"; fail "later run"; }
+  [ -s "$TMP/out/c.yml" ] || fail "the later run wrote no calibration"
+}
+
 run_case

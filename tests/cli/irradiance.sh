@@ -72,7 +72,7 @@ case_bad_query_file() {
   expect_bad_input "$TMP/none.csv" "$TMP/out.csv" -- \
     "$LUMAR" irradiance --envmap "$TMP/u.hdr" --query "$TMP/none.csv" --out "$TMP/out.csv"
   printf 'x,y,z,nx,ny,nz\n0,0,0,0,1,0\n1,2,three,0,1,0\n' >"$TMP/bad.csv"
-  expect_bad_input "line 3" "$TMP/out.csv" -- \
+  expect_bad_input "bad.csv:3:" "$TMP/out.csv" -- \
     "$LUMAR" irradiance --envmap "$TMP/u.hdr" --query "$TMP/bad.csv" --out "$TMP/out.csv"
   printf 'x,y,z,nx,ny\n0,0,0,0,1\n' >"$TMP/bad.csv"
   expect_bad_input "nz" "$TMP/out.csv" -- \
@@ -86,7 +86,7 @@ case_bad_query_file() {
     "$LUMAR" irradiance --envmap "$TMP/u.hdr" --query "$TMP/bad.csv" --out "$TMP/out.csv"
   # A point at 1e30 aborted inside Embree (SIGABRT, exit 134) under the reference.
   printf 'x,y,z,nx,ny,nz\n1e30,0,0,0,1,0\n' >"$TMP/bad.csv"
-  expect_bad_input "line 2: the point lies beyond" "$TMP/out.csv" -- \
+  expect_bad_input "bad.csv:2: the point lies beyond" "$TMP/out.csv" -- \
     "$LUMAR" irradiance --scene "$SRC/data/scenes/room/scene.json" --method reference --query "$TMP/bad.csv" \
     --out "$TMP/out.csv"
 }

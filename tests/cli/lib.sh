@@ -80,7 +80,7 @@ run_case() {
 }
 
 # expect_environment_error WHAT_STDERR_MUST_SAY DIR -- command...: a failure of the
-# environment (a full disk, a read-only folder): exit 1, one line on stderr saying it,
+# environment (a full disk, a read-only folder): exit 1, one error line on stderr saying it,
 # nothing final and no temporary left in DIR besides what was there before (DIR "-":
 # not checked).
 expect_environment_error() {
@@ -90,10 +90,11 @@ expect_environment_error() {
   [ "$dir" = - ] || before=$(ls -A "$dir" | sort)
   "$@" >"$TMP/stdout" 2>"$TMP/stderr" || status=$?
   [ $status -eq 1 ] || { cat "$TMP/stderr" >&2; fail "exit status $status, expected 1: $*"; }
-  [ "$(grep -c . "$TMP/stderr")" -eq 1 ] || { cat "$TMP/stderr" >&2; fail "expected one line on stderr"; }
-  grep -qF -- "$must_say" "$TMP/stderr" || { cat "$TMP/stderr" >&2; fail "stderr does not say '$must_say'"; }
+  # One error line, last; warnings the work gave before the failure may precede it.
+  [ "$(grep -c '^lumar: ' "$TMP/stderr")" -eq 1 ] || { cat "$TMP/stderr" >&2; fail "expected one error line on stderr"; }
+  tail -1 "$TMP/stderr" | grep -qF -- "$must_say" || { cat "$TMP/stderr" >&2; fail "the last line does not say '$must_say'"; }
   [ "$dir" = - ] || [ "$(ls -A "$dir" | sort)" = "$before" ] || fail "left in $dir: $(comm -13 <(echo "$before") <(ls -A "$dir" | sort) | tr '\n' ' ')"
-  echo "ok: $(head -1 "$TMP/stderr")"
+  echo "ok: $(tail -1 "$TMP/stderr")"
 }
 
 # with_file_size_limit KB command...: runs the command as if the disk filled up after KB
@@ -105,15 +106,19 @@ with_file_size_limit() {
 }
 
 # stop_midway SIGNAL WAIT_FOR -- command...: starts the command, waits until the work is
-# under way (WAIT_FOR: a glob a file must match, or "stderr:TEXT" the command must have
-# printed), sends the signal, and expects exit 130 within 2 s with a "stopped" line.
+# under way (WAIT_FOR: a glob a file must match, "stderr:TEXT" the command must have
+# printed, or "after:SECONDS" of running), sends the signal, and expects exit 130 within
+# 2 s with a "stopped" line.
 stop_midway() {
   local signal=$1 glob=$2
   shift 3
   "$@" >"$TMP/stdout" 2>"$TMP/stderr" &
   local pid=$! waited=0
   PIDS+=("$pid")
-  until if [ "${glob#stderr:}" != "$glob" ]; then grep -q "${glob#stderr:}" "$TMP/stderr"; else compgen -G "$glob" >/dev/null; fi; do
+  local started=$SECONDS
+  until if [ "${glob#stderr:}" != "$glob" ]; then grep -q "${glob#stderr:}" "$TMP/stderr";
+        elif [ "${glob#after:}" != "$glob" ]; then [ $((SECONDS - started)) -ge "${glob#after:}" ];
+        else compgen -G "$glob" >/dev/null; fi; do
     kill -0 "$pid" 2>/dev/null || { cat "$TMP/stderr"; fail "the command ended before $glob appeared"; }
     sleep 0.05
     waited=$((waited + 1))

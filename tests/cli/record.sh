@@ -7,8 +7,8 @@ source "$(dirname "$0")/lib.sh"
 VTEST="$SHARED/data/video/vtest.avi"
 
 # Every frame frames.csv lists decodes: the overlay writes one PNG per frame.
-check_readable() {  # recording, expected frames
-  "$LUMAR" overlay --recording "$1" --scene "$SRC/data/scenes/room/scene.json" --frames-dir "$TMP/check" \
+check_readable() {  # recording, expected frames, [overlay options]
+  "$LUMAR" overlay --recording "$1" "${@:3}" --scene "$SRC/data/scenes/room/scene.json" --frames-dir "$TMP/check" \
     >"$TMP/overlay.log" 2>&1 || { cat "$TMP/overlay.log"; fail "lumar overlay cannot read $1"; }
   local pngs
   pngs=$(find "$TMP/check" -name '*.png' | wc -l)
@@ -50,7 +50,10 @@ case_kill_9_keeps_all_but_the_last_second() {
   local records
   records=$(($(complete_lines "$TMP/raw.csv") - 1))
   [ "$records" -ge "$poses" ] || fail "poses.csv holds poses whose raw bytes are not in tracker.raw"
-  check_readable "$TMP/rec" "$frames"
+  # Overlay refuses the unclosed recording with a hint, and replays its closed frames when asked.
+  expect_bad_input "--allow-incomplete" "$TMP/check" -- "$LUMAR" overlay --recording "$TMP/rec" \
+    --scene "$SRC/data/scenes/room/scene.json" --frames-dir "$TMP/check"
+  check_readable "$TMP/rec" "$frames" --allow-incomplete
 }
 
 case_bad_frame_ends_with_a_valid_shorter_recording() {

@@ -3,6 +3,7 @@
 #include "lumar/scene/envmap.h"
 
 #include <gtest/gtest.h>
+#include <opencv2/imgcodecs.hpp>
 
 #include <cmath>
 #include <cstdio>
@@ -186,6 +187,25 @@ TEST(EnvironmentMap, BadFilesThrowInputErrorNamingTheFile) {
 
   save_environment_map(dir / "square.exr", gradient_map(64, 64));
   expect_input_error_naming(dir / "square.exr", "64x64");
+
+  // Negative radiance (once accepted, giving negative irradiance); a trace of ringing is kept.
+  EnvironmentMap map = gradient_map(64, 32);
+  map.rgb[5] = -1.f;
+  save_environment_map(dir / "ringing.exr", map);
+  EXPECT_EQ(load_environment_map(dir / "ringing.exr").rgb[5], -1.f);
+  for (std::size_t i = 0; i < map.rgb.size(); i += 2) map.rgb[i] = -map.rgb[i];
+  save_environment_map(dir / "negative.exr", map);
+  expect_input_error_naming(dir / "negative.exr", "negative radiance");
+
+  // An 8-bit PNG renamed .exr opens (the reader goes by content), but holds no radiance.
+  const cv::Mat png(32, 64, CV_8UC3, cv::Scalar(200, 100, 50));
+  ASSERT_TRUE(cv::imwrite((dir / "photo.png").string(), png));
+  std::filesystem::rename(dir / "photo.png", dir / "photo.exr");
+  expect_input_error_naming(dir / "photo.exr", "not high dynamic range");
+
+  std::filesystem::create_directories(dir / "folder.exr");
+  expect_input_error_naming(dir / "folder.exr", "is a directory");
+  expect_input_error_naming("/dev/zero", "is a device or a pipe");
 }
 
 }  // namespace

@@ -2,6 +2,7 @@
 // OBJ and glTF files written here, the error cases, and transformed() by hand.
 #include "lumar/scene/mesh.h"
 
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -17,6 +18,7 @@ namespace lumar {
 namespace {
 
 using test::Scratch;
+using ::testing::HasSubstr;
 
 void write_text(const std::filesystem::path& path, const std::string& text) {
   std::ofstream(path, std::ios::binary) << text;
@@ -229,6 +231,72 @@ TEST(Mesh, BadFilesThrowInputErrorNamingTheFile) {
   expect_throws_naming(dir / "points.ply");
   write_text(dir / "infinite.obj", "v 1e999 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
   expect_throws_naming(dir / "infinite.obj");
+}
+
+std::string load_error(const std::filesystem::path& path) {
+  try {
+    load_mesh(path);
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "(no error)";
+}
+
+// What fuzz_mesh found assimp trusting (an abort in an assertion, an out-of-bounds read):
+// the PLY is checked against its header first.
+TEST(Mesh, PlyDataThatDoesNotMatchItsHeaderIsRefused) {
+  const Scratch scratch("mesh-ply-check");
+  const auto& dir = scratch.dir;
+  const std::string head =
+      "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+      "element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n";
+  write_text(dir / "good.ply", head + "3 0 1 2\n");
+  EXPECT_EQ(load_mesh(dir / "good.ply").triangle_count(), 1u);
+  write_text(dir / "index.ply", head + "3 0 1 3\n");
+  EXPECT_THAT(load_error(dir / "index.ply"), HasSubstr("index.ply: PLY face 0 names vertex 3 of 3"));
+  write_text(dir / "short.ply", head + "3 0 1\n");
+  EXPECT_THAT(load_error(dir / "short.ply"), HasSubstr("short.ply: PLY data ends in face 0 of 1"));
+  write_text(dir / "word.ply", head + "3 0 one 2\n");
+  EXPECT_THAT(load_error(dir / "word.ply"), HasSubstr("word.ply: PLY value \"one\" is not a number"));
+  std::string garbled = head + "3 0 1 2\n";
+  garbled.replace(garbled.find("property float z"), 16, "prope\x8e\x8bt z");
+  write_text(dir / "garbled.ply", garbled);
+  EXPECT_THAT(load_error(dir / "garbled.ply"), HasSubstr("garbled.ply: PLY header line 6 is not a header line"));
+  std::string no_z = head + "3 0 1 2\n";
+  no_z.replace(no_z.find("property float z\n"), 17, "");
+  write_text(dir / "no-z.ply", no_z);
+  EXPECT_THAT(load_error(dir / "no-z.ply"), HasSubstr("no-z.ply: PLY vertices have no 'z' property"));
+  // Binary, big-endian: the same triangle, then a face whose index is 65538.
+  std::string bin =
+      "ply\nformat binary_big_endian 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+      "property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n";
+  const unsigned char one[4] = {0x3f, 0x80, 0, 0};  // 1.0f
+  std::string vertices(36, '\0');
+  std::copy(one, one + 4, vertices.begin() + 12);  // (1, 0, 0)
+  std::copy(one, one + 4, vertices.begin() + 28);  // (0, 1, 0)
+  const std::string face_ok = std::string("\x03", 1) + std::string("\0\0\0\0\0\0\0\x01\0\0\0\x02", 12);
+  write_text(dir / "big.ply", bin + vertices + face_ok);
+  EXPECT_EQ(load_mesh(dir / "big.ply").triangle_count(), 1u);
+  std::string face_bad = face_ok;
+  face_bad[1 + 8 + 1] = '\x01';  // the third index becomes 0x00010002
+  write_text(dir / "big-bad.ply", bin + vertices + face_bad);
+  EXPECT_THAT(load_error(dir / "big-bad.ply"), HasSubstr("names vertex 65538 of 3"));
+}
+
+// A mesh with faces but no area (once accepted silently, exit 0): all vertices equal, or
+// all on one line. A mesh with one real triangle among degenerate ones is fine.
+TEST(Mesh, DegenerateMeshesAreRefused) {
+  const Scratch scratch("mesh-degenerate");
+  const auto& dir = scratch.dir;
+  write_text(dir / "point.obj", "v 1 1 1\nv 1 1 1\nv 1 1 1\nf 1 2 3\n");
+  EXPECT_THAT(load_error(dir / "point.obj"), HasSubstr("point.obj: mesh is degenerate"));
+  write_text(dir / "line.obj", "v 0 0 0\nv 1 0 0\nv 2 0 0\nf 1 2 3\n");
+  EXPECT_THAT(load_error(dir / "line.obj"), HasSubstr("line.obj: mesh is degenerate"));
+  write_text(dir / "mixed.obj", "v 0 0 0\nv 1 0 0\nv 2 0 0\nv 0 1 0\nf 1 2 3\nf 1 2 4\n");
+  EXPECT_EQ(load_mesh(dir / "mixed.obj").triangle_count(), 2u);
+  std::filesystem::create_directories(dir / "folder.obj");
+  EXPECT_THAT(load_error(dir / "folder.obj"), HasSubstr("is a directory"));
+  EXPECT_THAT(load_error("/dev/zero"), HasSubstr("/dev/zero: mesh file is a device"));
 }
 
 // Counts in a PLY header are checked against the bytes after it before assimp reads

@@ -1,14 +1,13 @@
 #include "lumar/tracking/trajectory.h"
 
-#include <charconv>
 #include <cmath>
-#include <fstream>
 #include <map>
 #include <memory>
 #include <numbers>
-#include <sstream>
 
+#include "lumar/base/csv.h"
 #include "lumar/base/error.h"
+#include "lumar/base/input_file.h"
 #include "lumar/tracking/pose_stream.h"
 
 namespace lumar::tracking {
@@ -46,23 +45,6 @@ Pose spin(int station, Nanos t) {
   return p;
 }
 
-std::vector<std::string_view> split(std::string_view line) {
-  std::vector<std::string_view> fields;
-  std::size_t start = 0;
-  for (;;) {
-    const std::size_t comma = line.find(',', start);
-    fields.push_back(line.substr(start, comma == std::string_view::npos ? std::string_view::npos : comma - start));
-    if (comma == std::string_view::npos) return fields;
-    start = comma + 1;
-  }
-}
-
-template <class T>
-bool parse_number(std::string_view s, T& v) {
-  const auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
-  return ec == std::errc() && end == s.data() + s.size();
-}
-
 }  // namespace
 
 const std::vector<std::string>& builtin_trajectory_names() {
@@ -78,41 +60,27 @@ Trajectory builtin_trajectory(const std::string& name) {
 }
 
 Trajectory load_trajectory_csv(const std::filesystem::path& path) {
-  std::ifstream in(path);
-  if (!in) throw InputError(path.string() + ": cannot read the trajectory; check the path");
   const std::string where = path.string();
-  std::string line;
-  std::size_t line_number = 1;
-  if (!std::getline(in, line) || line.rfind("time_ns,station,x,y,z,qw,qx,qy,qz", 0) != 0)
-    throw InputError(where + ":1: the header must be time_ns,station,x,y,z,qw,qx,qy,qz (poses.csv)");
   auto stream = std::make_shared<PoseStream>();
   std::map<int, Nanos> last_time;
-  while (std::getline(in, line)) {
-    ++line_number;
-    if (!line.empty() && line.back() == '\r') line.pop_back();
-    if (line.empty()) continue;
-    const auto f = split(line);
-    auto fail = [&](const std::string& what) {
-      throw InputError(where + ":" + std::to_string(line_number) + ": " + what);
-    };
-    if (f.size() != 9) fail("expected 9 fields, found " + std::to_string(f.size()));
-    PoseSample s;
-    double v[7];
-    if (!parse_number(f[0], s.time) || !parse_number(f[1], s.station)) fail("time_ns and station must be integers");
-    for (int i = 0; i < 7; ++i)
-      if (!parse_number(f[2 + i], v[i]) || !std::isfinite(v[i]))
-        fail("field " + std::to_string(3 + i) + " is not a number");
-    if (s.station < 1 || s.station > 9) fail("station " + std::to_string(s.station) + " is outside 1..9");
-    const glm::dquat q(v[3], v[4], v[5], v[6]);
-    const double norm = glm::length(q);
-    if (std::abs(norm - 1.0) > 0.01) fail("the quaternion is not unit length");
-    if (auto it = last_time.find(s.station); it != last_time.end() && s.time < it->second)
-      fail("time goes backwards for station " + std::to_string(s.station));
-    last_time[s.station] = s.time;
-    s.T_transmitter_sensor.translation = {v[0], v[1], v[2]};
-    s.T_transmitter_sensor.rotation = q / norm;
-    stream->add(s);
-  }
+  csv::for_each_row(path, read_input_file(path, "trajectory"),
+                    {{"time_ns", "station", "x", "y", "z", "qw", "qx", "qy", "qz"}}, csv::LastLine::kRead,
+                    [&](const csv::Row& row) {
+                      PoseSample s;
+                      s.time = row.integer("time_ns");
+                      s.station = row.small_integer("station");
+                      if (s.station < 1 || s.station > 9)
+                        row.fail("station " + std::to_string(s.station) + " is outside 1..9");
+                      const glm::dquat q(row.real("qw"), row.real("qx"), row.real("qy"), row.real("qz"));
+                      const double norm = glm::length(q);
+                      if (std::abs(norm - 1.0) > 0.01) row.fail("the quaternion is not unit length");
+                      if (auto it = last_time.find(s.station); it != last_time.end() && s.time < it->second)
+                        row.fail("time goes backwards for station " + std::to_string(s.station));
+                      last_time[s.station] = s.time;
+                      s.T_transmitter_sensor.translation = {row.real("x"), row.real("y"), row.real("z")};
+                      s.T_transmitter_sensor.rotation = q / norm;
+                      stream->add(s);
+                    });
   if (stream->size() == 0) throw InputError(where + ": no poses; the trajectory needs at least one row");
   const int fallback = stream->stations().front();
   return [stream, fallback](int station, Nanos t) {

@@ -1,7 +1,6 @@
 #include "lumar/pipeline/envmap_images.h"
 
 #include <spdlog/spdlog.h>
-#include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -9,7 +8,9 @@
 #include <opencv2/imgcodecs.hpp>
 #include <sstream>
 
+#include "lumar/base/csv.h"
 #include "lumar/base/error.h"
+#include "lumar/base/input_file.h"
 #include "lumar/base/output_file.h"
 #include "lumar/calib/camera_file.h"
 #include "lumar/calib/camera_response.h"
@@ -31,93 +32,37 @@ struct PoseRow {
   int line = 0;
 };
 
-std::vector<std::string> split_fields(const std::string& line) {
-  std::vector<std::string> out;
-  std::stringstream ss(line);
-  std::string field;
-  while (std::getline(ss, field, ',')) {
-    const auto a = field.find_first_not_of(" \t"), b = field.find_last_not_of(" \t");
-    out.push_back(a == std::string::npos ? std::string() : field.substr(a, b - a + 1));
-  }
-  if (!line.empty() && line.back() == ',') out.emplace_back();
-  return out;
-}
-
-bool parse_double(const std::string& s, double& v) {
-  if (s.empty()) return false;
-  char* end = nullptr;
-  v = std::strtod(s.c_str(), &end);
-  return end == s.c_str() + s.size();
-}
-
 std::vector<PoseRow> read_poses_csv(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw InputError(path + ": cannot read the poses; check the path");
-  std::string line;
-  if (!std::getline(in, line))
-    throw InputError(path + ": empty; expected a header file,qw,qx,qy,qz[,x,y,z][,exposure][,station]");
-  if (!line.empty() && line.back() == '\r') line.pop_back();
-  const std::vector<std::string> header = split_fields(line);
-  std::map<std::string, int> column;
-  static const std::vector<std::string> kKnown{"file", "qw", "qx", "qy", "qz", "x", "y", "z", "exposure", "station"};
-  for (int i = 0; i < int(header.size()); ++i) {
-    if (std::find(kKnown.begin(), kKnown.end(), header[i]) == kKnown.end())
-      throw InputError(path + ":1: unknown column '" + header[i] +
-                       "'; the columns are file,qw,qx,qy,qz[,x,y,z][,exposure][,station]");
-    if (!column.emplace(header[i], i).second) throw InputError(path + ":1: column '" + header[i] + "' appears twice");
-  }
-  for (const char* required : {"file", "qw", "qx", "qy", "qz"})
-    if (!column.count(required))
-      throw InputError(path + ":1: no '" + required + "' column; the header must name file,qw,qx,qy,qz");
-  const int positions = int(column.count("x") + column.count("y") + column.count("z"));
-  if (positions != 0 && positions != 3) throw InputError(path + ":1: give all of x,y,z or none");
-
   std::vector<PoseRow> rows;
-  std::map<std::string, int> seen;
-  int line_number = 1;
-  while (std::getline(in, line)) {
-    ++line_number;
-    if (!line.empty() && line.back() == '\r') line.pop_back();
-    if (line.empty()) continue;
-    const std::string where = path + ":" + std::to_string(line_number) + ": ";
-    const auto f = split_fields(line);
-    if (f.size() != header.size())
-      throw InputError(where + "expected " + std::to_string(header.size()) + " fields, found " +
-                       std::to_string(f.size()));
-    auto number = [&](const char* name) {
-      double v = 0;
-      if (!parse_double(f[column.at(name)], v) || !std::isfinite(v))
-        throw InputError(where + name + " '" + f[column.at(name)] + "' is not a finite number");
-      return v;
-    };
-    PoseRow r;
-    r.line = line_number;
-    r.file = f[column.at("file")];
-    if (r.file.empty()) throw InputError(where + "the file name is empty");
-    if (auto [it, fresh] = seen.emplace(r.file, line_number); !fresh)
-      throw InputError(where + r.file + " already has a pose on line " + std::to_string(it->second));
-    const glm::dquat q(number("qw"), number("qx"), number("qy"), number("qz"));
-    const double norm = std::sqrt(q.w * q.w + q.x * q.x + q.y * q.y + q.z * q.z);
-    if (std::abs(norm - 1.0) > 1e-3)
-      throw InputError(where + "the quaternion of " + r.file + " has length " + std::to_string(norm) +
-                       "; give R_world_camera as a unit quaternion qw,qx,qy,qz");
-    r.rotation = q / norm;
-    if (positions == 3) r.position = glm::dvec3(number("x"), number("y"), number("z"));
-    if (column.count("exposure")) {
-      r.exposure = number("exposure");
-      if (!(r.exposure > 0))
-        throw InputError(where + "exposure must be positive (video linear value per unit radiance)");
-    }
-    if (column.count("station")) {
-      const std::string& s = f[column.at("station")];
-      int v = 0;
-      const auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
-      if (ec != std::errc() || end != s.data() + s.size())
-        throw InputError(where + "station '" + s + "' is not an integer");
-      r.station = v;
-    }
-    rows.push_back(r);
-  }
+  std::map<std::string, std::size_t> seen;
+  bool positions = false;
+  csv::for_each_row(path, read_input_file(path, "image poses file"),
+                    {{"file", "qw", "qx", "qy", "qz"}, {"x", "y", "z", "exposure", "station"}, false},
+                    csv::LastLine::kRead, [&](const csv::Row& row) {
+                      const int xyz = int(row.has("x")) + int(row.has("y")) + int(row.has("z"));
+                      if (xyz != 0 && xyz != 3) row.fail("give all of the columns x,y,z or none");
+                      positions = xyz == 3;
+                      PoseRow r;
+                      r.line = int(row.line());
+                      r.file = std::string(row.text("file"));
+                      if (r.file.empty()) row.fail("the file name is empty");
+                      if (auto [it, fresh] = seen.emplace(r.file, row.line()); !fresh)
+                        row.fail(r.file + " already has a pose on line " + std::to_string(it->second));
+                      const glm::dquat q(row.real("qw"), row.real("qx"), row.real("qy"), row.real("qz"));
+                      const double norm = std::sqrt(q.w * q.w + q.x * q.x + q.y * q.y + q.z * q.z);
+                      if (std::abs(norm - 1.0) > 1e-3)
+                        row.fail("the quaternion of " + r.file + " has length " + std::to_string(norm) +
+                                 "; give R_world_camera as a unit quaternion qw,qx,qy,qz");
+                      r.rotation = q / norm;
+                      if (positions) r.position = glm::dvec3(row.real("x"), row.real("y"), row.real("z"));
+                      if (row.has("exposure")) {
+                        r.exposure = row.real("exposure");
+                        if (!(r.exposure > 0))
+                          row.fail("exposure must be positive (video linear value per unit radiance)");
+                      }
+                      if (row.has("station")) r.station = row.small_integer("station");
+                      rows.push_back(r);
+                    });
   if (rows.empty()) throw InputError(path + ": no poses; one row per image is needed");
   return rows;
 }

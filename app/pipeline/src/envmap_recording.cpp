@@ -2,6 +2,8 @@
 
 #include <memory>
 
+#include <spdlog/spdlog.h>
+
 #include "lumar/base/error.h"
 #include "lumar/calib/camera_file.h"
 #include "lumar/calib/camera_response.h"
@@ -34,6 +36,7 @@ SweepInput recording_sweep_input(const std::string& recording, const std::string
                      "x" + std::to_string(size.height) + "; use the calibration of the camera that recorded it");
   if (replay->tracker_stats().records == 0)
     throw InputError(dir.string() + ": the recording has no tracker poses; a sweep needs the tracker's stream");
+  if (const auto& loss = replay->tracker_loss(); !loss.empty()) spdlog::warn("{}", loss);
 
   glm::dvec3 mean_position(0.0);
   for (const auto& f : frames) {

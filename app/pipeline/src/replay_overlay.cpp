@@ -14,6 +14,10 @@ double ms_since(std::chrono::steady_clock::time_point t0) {
 
 ReplayOverlay::ReplayOverlay(const std::filesystem::path& recording, const ReplayOverlaySettings& settings)
     : replay_(recording, settings.filter), pose_source_(settings.poses) {
+  if (!replay_.reader().complete() && !settings.allow_incomplete)
+    throw InputError(recording.string() + ": incomplete recording (\"complete\": false; its writer was killed, " +
+                     "crashed or ran out of disk); its " + std::to_string(replay_.reader().frames().size()) +
+                     " closed frames can be replayed with --allow-incomplete");
   const std::filesystem::path scene_path = settings.scene.empty() ? replay_.scene_path() : settings.scene;
   if (scene_path.empty()) throw InputError((recording / "session.json").string() + ": names no scene; pass --scene");
   auto scene = std::make_shared<const LoadedScene>(load_scene_files(scene_path));

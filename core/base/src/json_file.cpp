@@ -1,9 +1,7 @@
 #include "lumar/base/json_file.h"
 
-#include <fstream>
-#include <sstream>
-
 #include "lumar/base/error.h"
+#include "lumar/base/input_file.h"
 
 namespace lumar {
 
@@ -23,14 +21,7 @@ nlohmann::json parse_json_text(const std::string& text, const std::filesystem::p
 }
 
 nlohmann::json read_json_file(const std::filesystem::path& file, const std::string& what) {
-  std::error_code ec;
-  if (!std::filesystem::is_regular_file(file, ec))
-    throw InputError(file.string() + ": " + what + " not found (or not a file); check the path");
-  std::ifstream in(file, std::ios::binary);
-  std::stringstream text;
-  if (!in) throw InputError(file.string() + ": cannot read the " + what);
-  text << in.rdbuf();
-  return parse_json_text(text.str(), file);
+  return parse_json_text(read_input_file(file, what), file);
 }
 
 }  // namespace lumar

@@ -1,5 +1,7 @@
 #include "lumar/base/stop_signal.h"
 
+#include "lumar/base/error.h"
+
 #include <csignal>
 
 namespace lumar {
@@ -18,5 +20,9 @@ void catch_stop_signals() {
 }
 
 bool stop_requested() { return g_stop != 0; }
+
+void throw_if_stopped(const std::string& what) {
+  if (stop_requested()) throw Interrupted(what + "; nothing written");
+}
 
 }  // namespace lumar

@@ -8,6 +8,7 @@
 #include "decode_counter.h"
 #include "lumar/base/color.h"
 #include "lumar/base/error.h"
+#include "lumar/base/input_file.h"
 #include "lumar/base/latlong.h"
 #include "lumar/base/output_file.h"
 
@@ -58,7 +59,7 @@ double mean_luminance(const EnvironmentMap& map) {
 
 EnvironmentMap load_environment_map(const std::filesystem::path& path) {
   const std::string name = path.string();
-  if (!std::filesystem::is_regular_file(path)) throw InputError(name + ": environment map not found; check the path");
+  check_input_file(path, "environment map");
   auto in = OIIO::ImageInput::open(name);
   if (!in) {
     std::string why = OIIO::geterror();
@@ -67,6 +68,18 @@ EnvironmentMap load_environment_map(const std::filesystem::path& path) {
                      "); give an OpenEXR or Radiance HDR lat-long image");
   }
   const OIIO::ImageSpec& spec = in->spec();
+  const std::string format = in->format_name();
+  // The name's extension picks the reader only as a first guess: a PNG named .exr opens,
+  // and its 8-bit values would be taken for radiance.
+  std::string extension = path.extension().string();
+  std::transform(extension.begin(), extension.end(), extension.begin(),
+                 [](unsigned char c) { return std::tolower(c); });
+  const bool named_hdr = extension == ".exr" || extension == ".hdr";
+  if ((named_hdr && format != "openexr" && format != "hdr") ||
+      !(spec.format == OIIO::TypeDesc::HALF || spec.format == OIIO::TypeDesc::FLOAT ||
+        spec.format == OIIO::TypeDesc::DOUBLE || format == "hdr"))
+    throw InputError(name + ": environment map is a " + format + " image of " + std::string(spec.format.c_str()) +
+                     " pixels, not high dynamic range; give an OpenEXR or Radiance HDR lat-long image");
   const int w = spec.width, h = spec.height, channels = spec.nchannels;
   if (w <= 0 || h <= 0 || channels <= 0) throw InputError(name + ": environment map has no pixels");
   if (w != 2 * h)
@@ -96,6 +109,20 @@ EnvironmentMap load_environment_map(const std::filesystem::path& path) {
     throw InputError(name + ": environment map pixel (" + std::to_string(pixel % w) + ", " + std::to_string(pixel / w) +
                      ") is not finite; repair the map");
   }
+  // Radiance is never negative. A resampling filter's ringing leaves a few small negative
+  // values (the shared maps hold some, down to -0.003, a millionth of their energy); those
+  // are kept as the file has them. A map whose negative values weigh more is refused: it
+  // would give negative irradiance.
+  double negative = 0, positive = 0;
+  float lowest = 0.f;
+  for (float v : map.rgb) {
+    (v < 0.f ? negative : positive) += std::abs(double(v));
+    lowest = std::min(lowest, v);
+  }
+  if (negative > 1e-3 * positive)
+    throw InputError(name + ": environment map holds negative radiance (lowest value " + std::to_string(lowest) + ", " +
+                     std::to_string(int(std::round(100.0 * negative / std::max(positive, 1e-30)))) +
+                     " % of the positive total); radiance cannot be negative: repair the map");
   count_decode(path);
   return map;
 }

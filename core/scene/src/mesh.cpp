@@ -10,7 +10,8 @@
 
 #include "decode_counter.h"
 #include "lumar/base/error.h"
-#include "ply_size_check.h"
+#include "lumar/base/input_file.h"
+#include "ply_check.h"
 
 namespace lumar {
 
@@ -51,8 +52,8 @@ std::pair<glm::vec3, glm::vec3> Mesh::bounds() const {
 
 Mesh load_mesh(const std::filesystem::path& path) {
   const std::string name = path.string();
-  if (!std::filesystem::is_regular_file(path)) throw InputError(name + ": mesh file not found; check the path");
-  check_ply_sizes(path);
+  check_input_file(path, "mesh file");
+  check_ply(path);
 
   // Pre-transforming bakes the node hierarchy's transforms into the vertices, so a glTF
   // or OBJ whose parts are placed by nodes loads where its author put it. Normals are
@@ -106,6 +107,17 @@ Mesh load_mesh(const std::filesystem::path& path) {
     for (std::uint32_t i : part_indices) mesh.indices.push_back(base + i);
   }
   if (mesh.indices.empty()) throw InputError(name + ": mesh holds no triangles; export the model with its faces");
+  // A mesh whose every triangle has no area (all vertices equal, or in one line) has no
+  // surface to light or to shadow with, and no size to place by.
+  double area = 0;
+  for (std::size_t t = 0; t < mesh.indices.size(); t += 3) {
+    const glm::dvec3 p0 = mesh.positions[mesh.indices[t]], p1 = mesh.positions[mesh.indices[t + 1]],
+                     p2 = mesh.positions[mesh.indices[t + 2]];
+    area += 0.5 * glm::length(glm::cross(p1 - p0, p2 - p0));
+  }
+  if (!(area > 0) || !std::isfinite(area))
+    throw InputError(name + ": mesh is degenerate (no triangle of the " + std::to_string(mesh.triangle_count()) +
+                     " has an area, or the area is infinite); repair the model");
   count_decode(path);
   return mesh;
 }

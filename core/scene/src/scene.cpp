@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "lumar/base/error.h"
+#include "lumar/base/input_file.h"
 #include "lumar/base/json_file.h"
 #include "lumar/base/pose.h"
 
@@ -119,8 +120,8 @@ class ManifestReader {
   std::filesystem::path existing_file(const json& parent, const std::string& parent_key, const char* name) const {
     const std::filesystem::path given = string(parent, parent_key, name);
     const std::filesystem::path resolved = (folder_ / given).lexically_normal();
-    if (!std::filesystem::is_regular_file(resolved))
-      fail(join(parent_key, name), "file not found: " + resolved.string());
+    if (const auto problem = input_file_problem(resolved))
+      fail(join(parent_key, name), resolved.string() + " " + *problem);
     return resolved;
   }
 

@@ -31,8 +31,10 @@ class RecordingReader {
   const std::vector<FrameEntry>& frames() const { return frames_; }
   std::filesystem::path segment_file(int segment) const;
 
-  // Chunks up to the first torn or bad one; `ignored_bytes` gets the bytes after them.
-  std::vector<tracking::ByteChunk> tracker_chunks(std::size_t* ignored_bytes = nullptr) const;
+  // The whole chunks (parse_tracker_chunks); `ignored_bytes` gets the bytes in none,
+  // `torn_tail_bytes` those of them that are a last chunk cut short.
+  std::vector<tracking::ByteChunk> tracker_chunks(std::size_t* ignored_bytes = nullptr,
+                                                  std::size_t* torn_tail_bytes = nullptr) const;
   std::vector<tracking::PoseSample> poses() const;
   std::vector<TruthEntry> truth() const;             // empty when there is no truth.csv
   std::unique_ptr<FrameSource> open_frames() const;  // a RecordingSource

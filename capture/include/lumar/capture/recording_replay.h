@@ -15,8 +15,17 @@
 namespace lumar::capture {
 
 struct TrackerReplayStats {
-  std::size_t records = 0, rejected_records = 0, skipped_bytes = 0, torn_bytes = 0;
+  std::size_t stream_bytes = 0;  // tracker.raw's size
+  std::size_t records = 0, rejected_records = 0;
+  std::size_t skipped_bytes = 0;  // in whole chunks, that the protocol parser could not read
+  std::size_t damaged_bytes = 0;  // in damaged chunks (tracker_raw.h)
+  std::size_t torn_bytes = 0;     // a last chunk cut short by a crash: expected, not a loss
+  std::size_t lost_bytes() const { return skipped_bytes + damaged_bytes; }
+  double lost_fraction() const { return stream_bytes ? double(lost_bytes()) / double(stream_bytes) : 0.0; }
 };
+
+// Loss above this share of the tracker stream is warned about (a torn last chunk is not).
+inline constexpr double kTrackerLossWarning = 0.01;
 
 class RecordingReplay {
  public:
@@ -40,6 +49,9 @@ class RecordingReplay {
   // T_transmitter_sensor of the session's station, timed with the rig's latency.
   const tracking::PoseStream& sensor_poses() const { return poses_; }
   const TrackerReplayStats& tracker_stats() const { return stats_; }
+  // A warning to show when more than kTrackerLossWarning of the tracker stream was lost
+  // ("" otherwise): how much, where, and what it means.
+  const std::string& tracker_loss() const { return tracker_loss_; }
 
  private:
   RecordingReader reader_;
@@ -47,6 +59,7 @@ class RecordingReplay {
   tracking::PoseStream poses_;
   std::vector<TruthEntry> truth_;
   TrackerReplayStats stats_;
+  std::string tracker_loss_;
 };
 
 }  // namespace lumar::capture

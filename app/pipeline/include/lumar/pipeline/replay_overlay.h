@@ -21,6 +21,9 @@ struct ReplayOverlaySettings {
   PoseSource poses = PoseSource::Tracker;
   std::optional<tracking::PoseFilterSettings> filter;  // on the tracker's samples (not on the truth)
   OverlaySettings overlay;
+  // Replay a recording whose writer never closed it (killed, crashed, disk full): its
+  // closed segments are whole, but it may end early. Refused by default.
+  bool allow_incomplete = false;
 };
 
 class ReplayOverlay {
