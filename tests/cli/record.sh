@@ -101,6 +101,35 @@ case_full_disk_stops_cleanly() {
   [ -z "$(find "$TMP/full/video" -name 'segment-??????.avi')" ] || fail "a torn segment was published"
 }
 
+case_signals_end_the_recording_cleanly() {
+  # Ctrl-C (SIGINT) is how a recording is ended, and a service manager sends SIGTERM: both
+  # close it whole within 2 s (exit 0, "complete": true, every listed frame readable), and
+  # overlay takes it without --allow-incomplete.
+  for signal in INT TERM; do
+    start_emulator --rate 60
+    "$LUMAR" record --source "video:$VTEST" --tracker "serial:$TMP/tty" --out "$TMP/rec-$signal" \
+      >"$TMP/record.log" 2>&1 &
+    local recorder=$!
+    PIDS+=("$recorder")
+    wait_for 10 grep -q "^recording" "$TMP/record.log" || { cat "$TMP/record.log"; fail "record did not start"; }
+    wait_for 30 at_least_lines "$TMP/rec-$signal/frames.csv" 11 || { cat "$TMP/record.log"; fail "no frames recorded"; }
+    local t0 status=0
+    t0=$(date +%s%N)
+    kill -"$signal" "$recorder"
+    wait "$recorder" || status=$?
+    local ms=$((($(date +%s%N) - t0) / 1000000))
+    kill -TERM "$EMULATOR"
+    wait "$EMULATOR"
+    [ $status -eq 0 ] || { cat "$TMP/record.log"; fail "exit status $status after SIG$signal, expected 0"; }
+    [ $ms -lt 2000 ] || fail "took $ms ms to close after SIG$signal"
+    grep -q '"complete": true' "$TMP/rec-$signal/session.json" || fail "not closed whole after SIG$signal"
+    local frames
+    frames=$(($(complete_lines "$TMP/rec-$signal/frames.csv") - 1))
+    echo "SIG$signal: closed in $ms ms with $frames frames"
+    check_readable "$TMP/rec-$signal" "$frames"
+  done
+}
+
 case_live_overlay_runs_in_a_window() {
   command -v xvfb-run >/dev/null || fail "xvfb-run is not installed"
   start_emulator --rate 60
