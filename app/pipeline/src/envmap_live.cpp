@@ -159,8 +159,9 @@ void run_live_envmap(const LiveEnvmapOptions& o) {
   spdlog::info("envmap: {} frames, {} stitched, {} without a pose, {} updates of {}", loop.stats().frames,
                stitcher.frames_added(), skipped, updates, o.out.out);
   if (stitcher.frames_added() > 0) {
-    warn_about_exposure_range(stitcher, exposures);
-    compare_with_reference(stitcher.current_map(), stitcher.coverage(), reference);
+    const EnvironmentMap map = stitcher.current_map();
+    warn_about_exposure_range(stitcher, map, exposures);
+    compare_with_reference(map, stitcher.coverage(), reference);
   }
   if (o.refine_at_end && kept_all && !kept_frames.empty()) {
     spdlog::info("envmap: the sweep is over; refining its {} frames and stitching them again", kept_frames.size());

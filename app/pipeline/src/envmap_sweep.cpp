@@ -71,7 +71,8 @@ void write_corrections(const SweepInput& in, const calib::RefinementResult& resu
 
 }  // namespace
 
-void warn_about_exposure_range(const calib::EnvmapStitcher& stitcher, const std::vector<double>& exposures) {
+void warn_about_exposure_range(const calib::EnvmapStitcher& stitcher, const EnvironmentMap& map,
+                               const std::vector<double>& exposures) {
   // Too dark: regions no exposure lifted clear of the sensor's noise.
   const cv::Mat dark = stitcher.near_black(), coverage = stitcher.coverage();
   double dark_sr = 0, covered_sr = 0;
@@ -90,7 +91,6 @@ void warn_about_exposure_range(const calib::EnvmapStitcher& stitcher, const std:
         "the longest",
         100 * dark_sr / covered_sr, calib::EnvmapStitcher::kNearBlackCode);
   const cv::Mat clipped = stitcher.clipped();
-  const EnvironmentMap map = stitcher.current_map();
   const auto sources = calib::find_clipped_sources(map, clipped);
   if (sources.empty() || exposures.empty()) return;
   const auto [shortest, longest] = std::minmax_element(exposures.begin(), exposures.end());
@@ -173,13 +173,13 @@ void stitch_sweep(const SweepInput& in, const EnvmapOutputOptions& o) {
   if (sphere < kWellCoveredSphere)
     spdlog::warn("envmap: the frames saw {:.1f} % of the sphere; the other {:.1f} % is filled in, not measured",
                  100 * sphere, 100 * (1 - sphere));
-  warn_about_exposure_range(stitcher, in.exposures);
+  const EnvironmentMap map = stitcher.current_map();
+  warn_about_exposure_range(stitcher, map, in.exposures);
   int filled = 0;
-  const double covered = write_envmap_outputs(stitcher.current_map(), stitcher.coverage(), o, &filled);
+  const double covered = write_envmap_outputs(map, stitcher.coverage(), o, &filled);
   spdlog::info("envmap: wrote {} ({}x{}, {:.1f} % covered, {} pixels filled; {} frames in {:.2f} s incl. decoding)",
                o.out, stitcher.width(), stitcher.height(), 100.0 * covered, filled, n, seconds);
-  compare_with_reference(stitcher.current_map(), stitcher.coverage(),
-                         o.reference.empty() ? in.default_reference : o.reference);
+  compare_with_reference(map, stitcher.coverage(), o.reference.empty() ? in.default_reference : o.reference);
 }
 
 }  // namespace lumar::pipeline

@@ -57,7 +57,9 @@ struct SweepInput {
 // Warns when the exposures did not span the scene: regions that stayed near black in
 // every frame (their noise biases them up), and sources every frame saw clipped, the
 // shortest exposure too (calib/envmap/clipped_sources.h); names the exposure to add.
-void warn_about_exposure_range(const calib::EnvmapStitcher& stitcher, const std::vector<double>& exposures);
+// `map` is the stitcher's current_map(), made once by the caller (it is not cheap).
+void warn_about_exposure_range(const calib::EnvmapStitcher& stitcher, const EnvironmentMap& map,
+                               const std::vector<double>& exposures);
 
 // Refines, stitches, fills and writes every output asked for.
 void stitch_sweep(const SweepInput& input, const EnvmapOutputOptions& options);
