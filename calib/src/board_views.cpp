@@ -4,6 +4,7 @@
 
 #include "lumar/base/error.h"
 #include "lumar/base/input_file.h"
+#include "lumar/base/stop_signal.h"
 
 namespace lumar::calib {
 
@@ -11,6 +12,7 @@ std::vector<NamedImage> load_board_images(const std::vector<std::filesystem::pat
   std::vector<NamedImage> images;
   for (const auto& path : paths) {
     const std::string name = path.string();
+    throw_if_stopped("calibrate: while reading " + name);
     if (const auto problem = input_file_problem(path))
       throw InputError(name + ": image " + *problem + "; check the path or remove it from the list");
     cv::Mat grey = cv::imread(name, cv::IMREAD_GRAYSCALE);

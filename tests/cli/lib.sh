@@ -105,10 +105,19 @@ with_file_size_limit() {
   (trap '' XFSZ; ulimit -f "$kb"; exec "$@")  # bash counts -f in 1024-byte blocks
 }
 
+# handles_sigint PID: the process has installed its own SIGINT handler. Until then a
+# background job of a script ignores SIGINT (POSIX, without job control), so a signal
+# sent earlier would be lost, not handled.
+handles_sigint() {
+  local caught
+  caught=$(awk '/^SigCgt:/ { print $2 }' "/proc/$1/status" 2>/dev/null) || return 1
+  [ -n "$caught" ] && [ $((0x$caught & 0x2)) -ne 0 ]
+}
+
 # stop_midway SIGNAL WAIT_FOR -- command...: starts the command, waits until the work is
 # under way (WAIT_FOR: a glob a file must match, "stderr:TEXT" the command must have
-# printed, or "after:SECONDS" of running), sends the signal, and expects exit 130 within
-# 2 s with a "stopped" line.
+# printed, or "after:SECONDS" of running) and handles SIGINT, sends the signal, and
+# expects exit 130 within 2 s with a "stopped" line.
 stop_midway() {
   local signal=$1 glob=$2
   shift 3
@@ -116,7 +125,7 @@ stop_midway() {
   local pid=$! waited=0
   PIDS+=("$pid")
   local started=$SECONDS
-  until if [ "${glob#stderr:}" != "$glob" ]; then grep -q "${glob#stderr:}" "$TMP/stderr";
+  until handles_sigint "$pid" && if [ "${glob#stderr:}" != "$glob" ]; then grep -q "${glob#stderr:}" "$TMP/stderr";
         elif [ "${glob#after:}" != "$glob" ]; then [ $((SECONDS - started)) -ge "${glob#after:}" ];
         else compgen -G "$glob" >/dev/null; fi; do
     kill -0 "$pid" 2>/dev/null || { cat "$TMP/stderr"; fail "the command ended before $glob appeared"; }
