@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <bit>
+#include <cctype>
 #include <cstdint>
 #include <cstdlib>
 #include <cstring>
@@ -105,9 +106,16 @@ class Body {
 void check_ply(const std::filesystem::path& path) {
   std::ifstream in(path, std::ios::binary);
   std::string line;
-  if (!std::getline(in, line) || line.substr(0, 3) != "ply") return;
+  std::getline(in, line);
+  std::string extension = path.extension().string(), magic = line.substr(0, 3);
+  for (auto* s : {&extension, &magic})
+    std::transform(s->begin(), s->end(), s->begin(), [](unsigned char c) { return std::tolower(c); });
+  // assimp takes a .ply name, or "ply" in any case, for PLY: it looped forever on "pLy".
+  if (extension != ".ply" && magic != "ply") return;
   const std::string name = path.string();
   const auto bad = [&](const std::string& why) { throw InputError(name + ": " + why + "; repair or re-export it"); };
+  if (!line.empty() && line.back() == '\r') line.pop_back();
+  if (line != "ply") bad("not a PLY file (its first line must be \"ply\")");
   std::string format;
   std::vector<Element> elements;
   for (int n = 0;; ++n) {

@@ -11,7 +11,8 @@ namespace lumar {
 // property of unknown type, vertices without x, y and z), when a declared element cannot
 // fit in what follows the header, or when the data does not match the header: it ends
 // early, a list is longer than the rest of the file, or a face names a vertex index
-// outside 0..vertices-1. Files that do not start with "ply" are left alone.
+// outside 0..vertices-1, or when a file named .ply, or starting with "ply" in any case,
+// does not start with the line "ply". Other files are left alone.
 void check_ply(const std::filesystem::path& path);
 
 }  // namespace lumar
