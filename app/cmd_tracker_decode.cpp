@@ -1,22 +1,18 @@
 // lumar tracker decode: raw tracker bytes (a capture of the serial line, or a
 // recording's tracker.raw) -> CSV of poses, with a summary line on stderr.
 #include <cstdio>
-#include <filesystem>
-#include <fstream>
 #include <iostream>
-#include <iterator>
 #include <memory>
 #include <sstream>
 #include <string>
 
 #include "commands.h"
 #include "lumar/base/error.h"
+#include "lumar/base/input_file.h"
 #include "lumar/base/output_file.h"
 #include "lumar/capture/recording_format.h"
-#include "lumar/tracking/tracker_decode.h"
-// parse_tracker_chunks is private to capture/ (capture/src); the decoder needs exactly
-// that reader, so it is included from there rather than copied.
 #include "lumar/capture/tracker_raw.h"
+#include "lumar/tracking/tracker_decode.h"
 
 namespace lumar::app {
 
@@ -30,17 +26,6 @@ struct DecodeOptions {
   std::string list = "2,4,1";
   std::string out;
 };
-
-std::string read_file(const std::string& path) {
-  std::error_code ec;
-  if (!std::filesystem::is_regular_file(path, ec))
-    throw InputError(path + ": no such file; give a raw tracker capture or a recording's tracker.raw");
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(path + ": cannot be opened for reading; check its permissions");
-  std::string data((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  if (in.bad()) throw InputError(path + ": read failed; check the file");
-  return data;
-}
 
 bool has_chunk_magic(const std::string& data) {
   if (data.size() < 4) return false;
@@ -63,12 +48,12 @@ void run_decode(const DecodeOptions& o) {
     throw InputError(std::string("tracker decode: ") + e.what());
   }
   if (o.out != "-") refuse_output_over_input(o.out, {o.file});
-  const std::string data = read_file(o.file);
+  const std::string data = read_input_file(o.file, "raw tracker capture");
 
   std::vector<tracking::ByteChunk> chunks;
-  std::size_t torn_chunk_bytes = 0;
+  std::size_t ignored_bytes = 0, torn_chunk_bytes = 0;
   if (has_chunk_magic(data)) {
-    chunks = capture::parse_tracker_chunks(data, &torn_chunk_bytes);
+    chunks = capture::parse_tracker_chunks(data, &ignored_bytes, &torn_chunk_bytes);
   } else {
     chunks.push_back({0, std::vector<std::uint8_t>(data.begin(), data.end())});
   }
@@ -83,6 +68,8 @@ void run_decode(const DecodeOptions& o) {
     write_file_atomically(o.out, csv.str());
   }
   std::string summary = o.file + ": " + tracking::decode_summary(counts);
+  if (ignored_bytes > torn_chunk_bytes)
+    summary += ", " + std::to_string(ignored_bytes - torn_chunk_bytes) + " bytes of damaged chunks skipped";
   if (torn_chunk_bytes > 0) summary += ", " + std::to_string(torn_chunk_bytes) + " bytes of a torn chunk ignored";
   std::fprintf(stderr, "%s\n", summary.c_str());
 }

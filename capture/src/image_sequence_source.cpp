@@ -19,9 +19,7 @@ namespace {
 
 bool is_image(const fs::path& p) {
   static const std::set<std::string> kExtensions{".png", ".jpg", ".jpeg", ".bmp", ".tif", ".tiff", ".ppm"};
-  std::string ext = p.extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
-  return kExtensions.count(ext) > 0;
+  return kExtensions.count(lower_case_extension(p)) > 0;
 }
 
 std::vector<fs::path> expand(const std::string& pattern) {

@@ -75,10 +75,19 @@ std::vector<tracking::ByteChunk> parse_tracker_chunks(std::string_view data, std
   }
   if (ignored_bytes) *ignored_bytes = data.size() - good;
   if (torn_tail_bytes) {
-    // What follows the last whole chunk is a write cut short when it is the start of one.
-    const std::string_view tail = data.substr(end_of_good);
-    const bool starts_a_chunk = tail.substr(0, 4) == magic.substr(0, std::min<std::size_t>(4, tail.size()));
-    *torn_tail_bytes = starts_a_chunk && data.find(magic, end_of_good + 1) == std::string_view::npos ? tail.size() : 0;
+    // A write cut short: the last chunk after the whole ones runs past the end of the
+    // data (or its magic itself is cut). A damaged chunk before it is counted as damage.
+    std::size_t last = data.rfind(magic);
+    if (last == std::string_view::npos || last < end_of_good) last = end_of_good;
+    const std::string_view tail = data.substr(last);
+    bool torn = false;
+    if (tail.size() < 4) {
+      torn = tail == magic.substr(0, tail.size());
+    } else if (tail.substr(0, 4) == magic) {
+      torn =
+          tail.size() < kTrackerChunkHeaderBytes || tail.size() - kTrackerChunkHeaderBytes < get_le(p + last + 12, 4);
+    }
+    *torn_tail_bytes = torn ? tail.size() : 0;
   }
   return chunks;
 }

@@ -107,5 +107,11 @@ TEST(InputFile, MissingDirectoryDeviceAndUnreadableAreToldApart) {
   std::filesystem::remove_all(dir);
 }
 
+TEST(InputFile, ExtensionsAreComparedInLowerCase) {
+  EXPECT_EQ(lower_case_extension("dir.v2/MAP.EXR"), ".exr");
+  EXPECT_EQ(lower_case_extension("figurine.Ply"), ".ply");
+  EXPECT_EQ(lower_case_extension("dir.v2/README"), "");
+}
+
 }  // namespace
 }  // namespace lumar

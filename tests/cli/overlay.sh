@@ -155,13 +155,13 @@ case_live_headless_with_the_sessions_radiometry_and_a_filter() {
     --frames-dir "$TMP/live" >"$TMP/log" 2>&1 || { cat "$TMP/log"; fail "live overlay failed"; }
   cat "$TMP/log"
   # A live source drops the frames the overlay is too slow for (under ASan on a loaded
-  # machine 11 of the recording's 48 were shown before it ended): every frame shown is
-  # written, and up to the 12 asked for.
+  # machine 11 of the recording's 48 were shown before it ended, under ThreadSanitizer 3):
+  # every frame shown is written, more than one, and up to the 12 asked for.
   local shown written
   shown=$(sed -nE 's/^overlay: ([0-9]+) frames shown.*/\1/p' "$TMP/log")
   written=$(ls "$TMP/live" | wc -l)
-  [ -n "$shown" ] && [ "$written" -eq "$shown" ] && [ "$written" -ge 6 ] && [ "$written" -le 12 ] ||
-    fail "$written frames written, $shown shown; expected the same, 6 to 12"
+  [ -n "$shown" ] && [ "$written" -eq "$shown" ] && [ "$written" -ge 2 ] && [ "$written" -le 12 ] ||
+    fail "$written frames written, $shown shown; expected the same, 2 to 12"
   grep -q "lighting scale" "$TMP/log" || fail "no lighting adaptation on the live path"
   expect_bad_input "--filter kalman" "" -- "$LUMAR" overlay --recording "$REC" --filter kalman --frames-dir "$TMP/f"
   expect_bad_input "--rig" "" -- "$LUMAR" overlay --recording "$REC" --rig "$REC/session.json" --frames-dir "$TMP/f"

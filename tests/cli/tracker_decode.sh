@@ -87,13 +87,15 @@ case_fastrak_station_four() {
 }
 
 case_tracker_raw_chunks() {
-  # A recording's tracker.raw: record 1 split over two chunks, record 2 in a third,
-  # then a torn chunk (its header promises more bytes than follow).
+  # A recording's tracker.raw: record 1 split over two chunks, record 2 in a third, a
+  # damaged chunk (its CRC is wrong), then a torn chunk (its header promises more bytes
+  # than follow): the damage is counted apart from the torn tail a crash leaves.
   printf '%s' "${REC1:0:30}" >"$TMP/p1"
   printf '%s' "${REC1:30}" >"$TMP/p2"
   printf '%s' "$REC2" >"$TMP/p3"
   : >"$TMP/tracker.raw"
   for p in p1 p2 p3; do append_chunk "$TMP/$p" "$TMP/tracker.raw"; done
+  printf 'LTRK\0\0\0\0\0\0\0\0\x03\0\0\0\0\0\0\0xyz' >>"$TMP/tracker.raw"
   printf 'LTRK\0\0\0\0\0\0\0\0\x40\0\0\0\0\0\0\0abc' >>"$TMP/tracker.raw"
   "$LUMAR" tracker decode "$TMP/tracker.raw" --out "$TMP/poses.csv" >"$TMP/stdout" 2>"$TMP/stderr" \
     || fail "exit status $?"
@@ -101,7 +103,7 @@ case_tracker_raw_chunks() {
   no_temporaries "$TMP"
   printf '%s\n' "$HEADER" "$ROW1" "$ROW2" >"$TMP/expected.csv"
   diff -u "$TMP/expected.csv" "$TMP/poses.csv" || fail "CSV differs"
-  grep -qF "2 records, 0 rejected records, 0 skipped bytes, 23 bytes of a torn chunk ignored" "$TMP/stderr" \
+  grep -qF "2 records, 0 rejected records, 0 skipped bytes, 23 bytes of damaged chunks skipped, 23 bytes of a torn chunk ignored" "$TMP/stderr" \
     || { cat "$TMP/stderr" >&2; fail "summary"; }
   echo "ok: $(cat "$TMP/stderr")"
 }

@@ -109,13 +109,13 @@ Compared compare_live_with_replay(const std::filesystem::path& dir, int adapt_li
   return c;
 }
 
-constexpr int kFewestLiveFrames = 8;
+// A live source drops the frames the overlay is too slow for (36 of 48 at release speed;
+// under ThreadSanitizer 42), so only a few compared frames are certain on any machine.
+constexpr int kFewestLiveFrames = 4;
 
 TEST(LiveOverlay, FramesMatchTheReplayOfTheSameInputs) {
   const Compared c = compare_live_with_replay(still_recording(), 0);
   std::printf("%d live frames with a pose, worst PSNR against the replay %.1f dB\n", c.frames, c.worst_psnr);
-  // A live source drops the frames the overlay is too slow for (36 of 48 at release speed,
-  // more under the sanitizers), so only a few compared frames are certain on any machine.
   EXPECT_GE(c.frames, kFewestLiveFrames);
   EXPECT_GE(c.worst_psnr, 40.0);
 }
@@ -127,10 +127,10 @@ TEST(LiveOverlay, AdaptsTheLightingAsTheReplayDoes) {
   const auto dir = scratch.dir / "brighter";
   std::filesystem::copy(still_recording(), dir, std::filesystem::copy_options::recursive);
   capture::update_session_file(dir, [](capture::Session& s) { s.radiometry.exposure *= 2; });
-  const Compared c = compare_live_with_replay(dir, 4);
+  const Compared c = compare_live_with_replay(dir, 2);
   std::printf("%d frames; lighting scale live %.4f, replay %.4f; worst PSNR %.1f dB\n", c.frames, c.live_scale,
               c.replay_scale, c.worst_psnr);
-  EXPECT_GE(c.frames, kFewestLiveFrames);  // two lighting updates at least (every 4 frames)
+  EXPECT_GE(c.frames, kFewestLiveFrames);  // two lighting updates at least (every 2 frames)
   EXPECT_NEAR(c.replay_scale, 0.5, 0.05);
   EXPECT_NEAR(c.live_scale, c.replay_scale, 0.01);
   EXPECT_GE(c.worst_psnr, 35.0);

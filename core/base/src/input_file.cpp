@@ -1,6 +1,8 @@
 #include "lumar/base/input_file.h"
 
 #include <unistd.h>
+
+#include <cctype>
 #include <fstream>
 #include <sstream>
 
@@ -38,6 +40,12 @@ std::string read_input_file(const fs::path& file, const std::string& what, std::
   text << in.rdbuf();
   if (in.bad()) throw InputError(file.string() + ": read error in the " + what + "; check the disk");
   return std::move(text).str();
+}
+
+std::string lower_case_extension(const std::filesystem::path& file) {
+  std::string extension = file.extension().string();
+  for (char& c : extension) c = char(std::tolower(static_cast<unsigned char>(c)));
+  return extension;
 }
 
 }  // namespace lumar

@@ -71,9 +71,7 @@ EnvironmentMap load_environment_map(const std::filesystem::path& path) {
   const std::string format = in->format_name();
   // The name's extension picks the reader only as a first guess: a PNG named .exr opens,
   // and its 8-bit values would be taken for radiance.
-  std::string extension = path.extension().string();
-  std::transform(extension.begin(), extension.end(), extension.begin(),
-                 [](unsigned char c) { return std::tolower(c); });
+  const std::string extension = lower_case_extension(path);
   const bool named_hdr = extension == ".exr" || extension == ".hdr";
   if ((named_hdr && format != "openexr" && format != "hdr") ||
       !(spec.format == OIIO::TypeDesc::HALF || spec.format == OIIO::TypeDesc::FLOAT ||

@@ -1,8 +1,8 @@
 #include "ply_check.h"
 
+#include <strings.h>
 #include <algorithm>
 #include <bit>
-#include <cctype>
 #include <cstdint>
 #include <cstdlib>
 #include <cstring>
@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "lumar/base/error.h"
+#include "lumar/base/input_file.h"
 
 namespace lumar {
 
@@ -107,11 +108,8 @@ void check_ply(const std::filesystem::path& path) {
   std::ifstream in(path, std::ios::binary);
   std::string line;
   std::getline(in, line);
-  std::string extension = path.extension().string(), magic = line.substr(0, 3);
-  for (auto* s : {&extension, &magic})
-    std::transform(s->begin(), s->end(), s->begin(), [](unsigned char c) { return std::tolower(c); });
   // assimp takes a .ply name, or "ply" in any case, for PLY: it looped forever on "pLy".
-  if (extension != ".ply" && magic != "ply") return;
+  if (lower_case_extension(path) != ".ply" && strncasecmp(line.c_str(), "ply", 3) != 0) return;
   const std::string name = path.string();
   const auto bad = [&](const std::string& why) { throw InputError(name + ": " + why + "; repair or re-export it"); };
   if (!line.empty() && line.back() == '\r') line.pop_back();

@@ -23,4 +23,7 @@ void check_input_file(const std::filesystem::path& file, const std::string& what
 std::string read_input_file(const std::filesystem::path& file, const std::string& what,
                             std::size_t max_bytes = std::size_t(1) << 30);
 
+// The name's extension in lower case (".exr" for "MAP.EXR"), for choosing a reader by name.
+std::string lower_case_extension(const std::filesystem::path& file);
+
 }  // namespace lumar
