@@ -67,6 +67,12 @@ void register_synth(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--quality", s->quality, "MJPEG quality")->check(CLI::Range(50, 100))->capture_default_str();
   cmd->add_option("--seed", s->seed, "Random seed for noise")->capture_default_str();
+  cmd->add_flag("--truth", s->truth,
+                "Also write truth/: the frames with the scene's objects physically present, by brute force, and "
+                "their masks (docs/ground_truth.md)");
+  cmd->add_option("--truth-seed", s->truth_seed,
+                  "--truth: the noise seed of the second truth (truth/other-seed-*), the noise floor; 0 = --seed + 1")
+      ->capture_default_str();
   // --board: the tracked camera filming a checkerboard, for `lumar calibrate-rig`.
   auto b = std::make_shared<sim::BoardSynthSettings>();
   auto board = std::make_shared<std::string>();

@@ -29,6 +29,31 @@ case_synth_then_regress() {
   "$LUMAR" regress "$TMP/rec" | tee "$TMP/regress" || fail "regress on a fresh synthetic recording failed"
 }
 
+case_truth_beside_the_video() {
+  # --truth: each frame again with the figurine physically present, the same with another
+  # noise seed, and the figurine's mask (docs/ground_truth.md); a scene without objects
+  # has no truth to render.
+  "$LUMAR" synth --scene "$SCENE" --camera "$CAM" --out "$TMP/rec" --frames 2 --supersample 1 --truth \
+    >"$TMP/log" 2>&1 || { cat "$TMP/log"; fail "synth --truth failed"; }
+  local kind
+  for kind in frame other-seed mask; do
+    [ "$(ls "$TMP/rec/truth/$kind"-*.png | wc -l)" -eq 2 ] || fail "expected 2 truth/$kind-*.png"
+  done
+  cmp -s "$TMP/rec/truth/frame-00000.png" "$TMP/rec/truth/other-seed-00000.png" && fail "the two seeds agree"
+  # The same scene without its figurine, its files named by absolute paths.
+  python3 - "$SCENE" "$TMP/empty.json" <<'PY'
+import json, os, sys
+here = os.path.dirname(os.path.abspath(sys.argv[1]))
+s = json.load(open(sys.argv[1]))
+s["objects"] = []
+s["room"]["mesh"] = os.path.join(here, s["room"]["mesh"])
+s["environment_map"]["path"] = os.path.join(here, s["environment_map"]["path"])
+json.dump(s, open(sys.argv[2], "w"))
+PY
+  expect_bad_input "--truth needs objects" "$TMP/empty" -- \
+    "$LUMAR" synth --scene "$TMP/empty.json" --camera "$CAM" --out "$TMP/empty" --frames 2 --truth
+}
+
 case_synth_refuses_existing_output() {
   mkdir -p "$TMP/rec"
   touch "$TMP/rec/keep-me"

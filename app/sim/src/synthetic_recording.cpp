@@ -9,13 +9,18 @@
 #include "lumar/base/color.h"
 #include "lumar/base/error.h"
 #include "lumar/base/stop_signal.h"
+#include "lumar/calib/image_file.h"
 #include "lumar/calib/undistortion.h"
 #include "lumar/capture/recording_writer.h"
 #include "lumar/capture/session.h"
+#include "lumar/lighting/composite_reference.h"
+#include "lumar/lighting/irradiance_reference.h"
+#include "lumar/lighting/irradiance_scene.h"
 #include "lumar/render/platform/context.h"
 #include "lumar/render/renderer.h"
 #include "lumar/scene/loaded_scene.h"
 #include "lumar/sim/envmap_view.h"
+#include "lumar/sim/truth_frame.h"
 #include "lumar/tracking/simulated_tracker.h"
 #include "lumar/tracking/tracker_stream.h"
 
@@ -220,12 +225,42 @@ void synthesize_recording(const SynthSettings& s) {
   session.radiometry.vignetting_a = s.vignetting_a;
   session.radiometry.vignetting_b = s.vignetting_b;
 
+  // The truth: the room's light on the objects physically present, by brute force, from
+  // a map of 128 rows (its bright texels summed exactly, the rest by rays).
+  std::unique_ptr<RoomRadiance> truth_room;
+  std::unique_ptr<CompositeReference> truth;
+  if (s.truth) {
+    if (scene.objects.empty()) throw InputError(s.scene.string() + ": --truth needs objects in the scene");
+    RadianceSettings radiance = reference_radiance_settings();
+    radiance.map_height = 128;
+    truth_room = scene_radiance(scene, radiance);
+    truth = std::make_unique<CompositeReference>(*truth_room, scene.objects);
+  }
+  cv::RNG other_seed(s.truth_seed != 0 ? s.truth_seed : s.seed + 1);
+  TruthSettings truth_settings;
+  truth_settings.ratio_stride = s.truth_ratio_stride;
+
   const capture::RecordingSettings video{
       .codec = s.codec, .quality = s.quality, .fps = s.fps, .size = cv::Size(s.camera.width, s.camera.height)};
   write_synthetic_recording(
       s.out, session, tracker, video, s.frames, s.seed, [&](int k) { return start + frame_period * k; }, true_camera,
-      [&](int, Nanos, const Pose& T_world_camera, cv::RNG& rng) {
+      [&](int k, Nanos, const Pose& T_world_camera, cv::RNG& rng) {
         const cv::Mat radiance = renderer.render_room_radiance(pinhole, T_world_camera);
+        if (truth) {
+          // The video's own noise, drawn again for the truth, so that only the objects differ.
+          cv::RNG same_noise = rng;
+          const TruthFrame frame = render_truth_frame(*truth, pinhole, T_world_camera, radiance, truth_settings);
+          const cv::Mat seen = calib::distort_image(frame.radiance, pinhole, s.camera);
+          const std::filesystem::path dir = s.out / "truth";
+          std::filesystem::create_directories(dir);
+          calib::write_image_atomically(dir / fmt::format("frame-{:05d}.png", k),
+                                        expose(seen, s.camera, s, exposure, same_noise));
+          calib::write_image_atomically(dir / fmt::format("other-seed-{:05d}.png", k),
+                                        expose(seen, s.camera, s, exposure, other_seed));
+          cv::Mat mask;
+          cv::compare(calib::distort_image(frame.coverage, pinhole, s.camera), 0.5, mask, cv::CMP_GT);
+          calib::write_image_atomically(dir / fmt::format("mask-{:05d}.png", k), mask);
+        }
         return expose(calib::distort_image(radiance, pinhole, s.camera), s.camera, s, exposure, rng);
       });
   spdlog::info("synth: wrote {} ({} frames, exposure {:.4g}, tracker {} records)", s.out.string(), s.frames, exposure,

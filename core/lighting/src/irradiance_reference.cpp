@@ -4,24 +4,15 @@
 
 #include <cmath>
 #include <functional>
+#include <limits>
 #include <numbers>
 #include <random>
 
+#include "hemisphere_sampling.h"
 #include "lumar/base/constants.h"
 #include "lumar/base/latlong.h"
 
 namespace lumar {
-
-namespace {
-
-// An orthonormal frame around n (Duff et al. 2017).
-void basis(const glm::dvec3& n, glm::dvec3& t, glm::dvec3& b) {
-  const double s = n.z >= 0.0 ? 1.0 : -1.0;
-  const double a = -1.0 / (s + n.z), c = n.x * n.y * a;
-  t = {1.0 + s * n.x * n.x * a, s * c, -s * n.x};
-  b = {c, s + n.y * n.y * a, -n.y};
-}
-}  // namespace
 
 glm::dvec3 texel_sum_irradiance(const EnvironmentMap& map, const glm::dvec3& normal) {
   const glm::dvec3 n = glm::normalize(normal);
@@ -81,10 +72,10 @@ RadianceSettings reference_radiance_settings() {
 }
 
 glm::dvec3 reference_irradiance(const RoomRadiance& room, const glm::dvec3& point, const glm::dvec3& normal,
-                                int strata) {
+                                const glm::dvec3& off_surface, int strata, const ExtraOccluder& occluder) {
   const glm::dvec3 n = glm::normalize(normal);
   // Off the surface a little, so that rays leaving a point on the proxy do not hit it.
-  const glm::dvec3 p = point + n * 1e-4;
+  const glm::dvec3 p = point + off_surface * 1e-4;
   glm::dvec3 bright(0.0);
   for (const BrightTexel& t : room.bright_texels()) {
     glm::dvec3 toward;
@@ -92,24 +83,34 @@ glm::dvec3 reference_irradiance(const RoomRadiance& room, const glm::dvec3& poin
         room.solid_angle_from(p, t.on_proxy, t.position, t.normal, t.direction, t.solid_angle, &toward);
     const double cosine = glm::dot(n, toward);
     if (omega <= 0.0 || cosine <= 0.0) continue;
-    if (room.sees(p, t.on_proxy, t.position, t.direction)) bright += t.radiance * omega * cosine;
+    if (!room.sees(p, t.on_proxy, t.position, t.direction)) continue;
+    if (occluder) {
+      const double reach = t.on_proxy ? glm::length(t.position - p) - 2e-3 : std::numeric_limits<double>::infinity();
+      if (occluder(p, toward, reach)) continue;
+    }
+    bright += t.radiance * omega * cosine;
   }
   glm::dvec3 tangent, bitangent;
-  basis(n, tangent, bitangent);
-  const std::size_t seed =
-      std::hash<double>{}(point.x * 1e3 + point.y * 7e3 + point.z * 13e3 + n.x * 3 + n.y * 5 + n.z * 11);
-  std::mt19937 rng{std::uint32_t(seed)};
+  orthonormal_basis(n, tangent, bitangent);
+  std::mt19937 rng{query_seed(point, n)};
   std::uniform_real_distribution<double> jitter(0.0, 1.0);
   glm::dvec3 dim(0.0);
   for (int i = 0; i < strata; ++i)
     for (int j = 0; j < strata; ++j) {
       const double u1 = (i + jitter(rng)) / strata, u2 = (j + jitter(rng)) / strata;
-      const double r = std::sqrt(u1), phi = 2.0 * kPi * u2;
-      const glm::dvec3 w = tangent * (r * std::cos(phi)) + bitangent * (r * std::sin(phi)) + n * std::sqrt(1.0 - u1);
-      dim += room.dim_radiance(p, glm::normalize(w)).radiance;
+      const glm::dvec3 w = cosine_direction(n, tangent, bitangent, u1, u2);
+      const RoomRadiance::Sample sample = room.dim_radiance(p, w);
+      if (occluder && occluder(p, w, sample.distance)) continue;
+      dim += sample.radiance;
     }
   // Cosine-weighted sampling: pdf = cos / π, so E = π · mean(L).
   return bright + dim * (kPi / double(strata * strata));
+}
+
+glm::dvec3 reference_irradiance(const RoomRadiance& room, const glm::dvec3& point, const glm::dvec3& normal,
+                                int strata) {
+  const glm::dvec3 n = glm::normalize(normal);
+  return reference_irradiance(room, point, n, n, strata, nullptr);
 }
 
 std::vector<glm::dvec3> reference_irradiance(const RoomRadiance& room, std::span<const glm::dvec3> points,

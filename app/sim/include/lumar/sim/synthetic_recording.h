@@ -36,6 +36,11 @@ struct SynthSettings {
   std::string codec = "mjpeg";
   int quality = 95;
   std::uint64_t seed = 1;
+  // truth/ beside the video: the same frames with the objects physically present
+  // (docs/ground_truth.md), with the video's noise and with another seed's.
+  bool truth = false;
+  std::uint64_t truth_seed = 0;  // the other seed; 0: seed + 1
+  int truth_ratio_stride = 4;    // TruthSettings::ratio_stride, in rendered (supersampled) pixels
 };
 
 // The session's record of the settings every synthetic recording shares ("synth").

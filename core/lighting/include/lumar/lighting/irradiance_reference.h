@@ -6,6 +6,7 @@
 //    area lights with a visibility ray each (so small lights are never missed), plus
 //    the rest by stratified cosine-weighted hemisphere sampling with many rays, each
 //    traced against the proxy (exact visibility).
+#include <functional>
 #include <glm/glm.hpp>
 #include <span>
 #include <vector>
@@ -26,6 +27,14 @@ RadianceSettings reference_radiance_settings();
 // E(p, n) with strata × strata cosine-weighted rays (one jittered ray per stratum,
 // seeded by the query so results are reproducible).
 glm::dvec3 reference_irradiance(const RoomRadiance& room, const glm::dvec3& p, const glm::dvec3& n, int strata = 64);
+// Whether something besides the proxy lies on p + t·w (w unit) for t in (0, t_far);
+// t_far infinite: out to infinity. Virtual objects, for composite_reference.h.
+using ExtraOccluder = std::function<bool(const glm::dvec3& p, const glm::dvec3& w, double t_far)>;
+// The same with `occluder` blocking rays and bright texels too (none when empty); rays
+// start off the surface along `off_surface` (a geometric normal where `normal` is a
+// shading normal).
+glm::dvec3 reference_irradiance(const RoomRadiance& room, const glm::dvec3& p, const glm::dvec3& normal,
+                                const glm::dvec3& off_surface, int strata, const ExtraOccluder& occluder);
 // Many queries at once (parallel over queries).
 std::vector<glm::dvec3> reference_irradiance(const RoomRadiance& room, std::span<const glm::dvec3> points,
                                              std::span<const glm::dvec3> normals, int strata = 64);
