@@ -13,7 +13,10 @@
 #include "lumar/base/error.h"
 #include "lumar/base/json_file.h"
 #include "lumar/base/output_file.h"
+#include "lumar/calib/camera_response.h"
 #include "lumar/calib/image_file.h"
+#include "lumar/calib/undistortion.h"
+#include "lumar/pipeline/composite_error.h"
 #include "lumar/pipeline/replay_overlay.h"
 
 namespace lumar::app {
@@ -27,7 +30,7 @@ struct RegressOptions {
   std::vector<std::string> recordings;
   std::string root = "recordings";
   std::string scene;  // instead of the one the session names (a live recording names none)
-  bool update = false, no_cache = false, allow_incomplete = false;
+  bool update = false, no_cache = false, allow_incomplete = false, json = false;
 };
 
 const cv::Size kGoldenSize(160, 120);
@@ -75,7 +78,43 @@ double render_vs_opencv_px(Compositor& compositor, const Pose& T_world_camera, s
 struct Outcome {
   bool pass = true;
   std::string line;
+  json record;  // --json: what the line says, by key
 };
+
+// The composite against truth/ (docs/ground_truth.md), replayed with the true poses so
+// that registration is not part of the measure; nothing when the recording has no truth.
+std::optional<pipeline::CompositeError> composite_error(const fs::path& dir, const RegressOptions& o) {
+  const fs::path truth = dir / "truth";
+  if (!fs::is_directory(truth)) return std::nullopt;
+  pipeline::ReplayOverlaySettings settings;
+  settings.scene = o.scene;
+  settings.poses = pipeline::PoseSource::Truth;
+  settings.overlay.volume_cache = !o.no_cache;
+  settings.allow_incomplete = o.allow_incomplete;
+  pipeline::ReplayOverlay overlay(dir, settings);
+  const capture::Session& session = overlay.replay().session();
+  const calib::UndistortionMaps maps = calib::make_undistortion_maps(session.camera, settings.overlay.undistortion);
+  pipeline::CompositeErrorMeter meter(
+      calib::calibrated_response(session.radiometry, dir).value_or(calib::srgb_response(1.0)));
+  const auto read = [&](const char* kind, std::int64_t index, int flags) {
+    const fs::path file = truth / fmt::format("{}-{:05d}.png", kind, index);
+    const cv::Mat image = cv::imread(file.string(), flags);
+    if (image.empty()) throw InputError(file.string() + ": missing or unreadable truth frame");
+    if (image.size() != maps.map_x.size())
+      throw InputError(file.string() + ": truth frame is " + std::to_string(image.cols) + "x" +
+                       std::to_string(image.rows) + ", not the video's size");
+    return calib::undistort_image(image, maps);
+  };
+  overlay.run(0, [&](const pipeline::OverlayFrame& f) {
+    if (!f.T_world_camera) return true;
+    const cv::Mat mask = read("mask", f.index, cv::IMREAD_GRAYSCALE) > 127;
+    // The empty room uncompressed, so that the video codec's loss is not taken for a shadow.
+    meter.add(f.composite, read("frame", f.index, cv::IMREAD_COLOR), read("other-seed", f.index, cv::IMREAD_COLOR),
+              read("empty", f.index, cv::IMREAD_COLOR), mask);
+    return true;
+  });
+  return meter.result();
+}
 
 Outcome regress_one(const fs::path& dir, const RegressOptions& o) {
   const bool update = o.update;
@@ -178,6 +217,7 @@ Outcome regress_one(const fs::path& dir, const RegressOptions& o) {
   const double psnr_limit = expected.at("psnr_min_db").get<double>();
   const double tracked_limit = expected.at("tracked_projection_mean_px_max").get<double>();
   const double render_limit = expected.at("render_projection_mean_px_max").get<double>();
+  const auto measured = composite_error(dir, o);
   Outcome out;
   out.pass = (update || psnr_min >= psnr_limit) && tracked_mean <= tracked_limit && render_error <= render_limit &&
              render_samples > 0 && tracked_errors.size() == frames.size();
@@ -190,6 +230,31 @@ Outcome regress_one(const fs::path& dir, const RegressOptions& o) {
       tracked_errors.size() == frames.size()
           ? ""
           : fmt::format("; {} frames lacked a pose", frames.size() - tracked_errors.size()));
+  out.record = {{"recording", dir.string()},
+                {"pass", out.pass},
+                {"frames", frames.size()},
+                {"golden_psnr_min_db", update ? json(nullptr) : json(psnr_min)},
+                {"tracked_projection_mean_px", tracked_mean},
+                {"render_projection_mean_px", render_error}};
+  for (const char* key : {"object_err", "edge_err", "shadow_err", "noise_ratio", "noise_floor_object_err",
+                          "noise_floor_edge_err", "noise_floor_shadow_err"})
+    out.record[key] = nullptr;
+  if (measured) {
+    const pipeline::CompositeError& e = *measured;
+    out.line += fmt::format(
+        "\n  composite vs truth (true poses, {} frames, 5x5 box, linear): object {:.2f} % (noise floor {:.2f} %), "
+        "edge {:.2f} % ({:.2f} %), shadow {:.2f} % ({:.2f} %) over {} / {} / {} pixels; noise ratio {:.2f}",
+        e.frames, e.object_err, e.noise_floor_object_err, e.edge_err, e.noise_floor_edge_err, e.shadow_err,
+        e.noise_floor_shadow_err, e.pixels[0], e.pixels[1], e.pixels[2], e.noise_ratio);
+    out.record["object_err"] = e.object_err;
+    out.record["edge_err"] = e.edge_err;
+    out.record["shadow_err"] = e.shadow_err;
+    out.record["noise_ratio"] = e.noise_ratio;
+    out.record["noise_floor_object_err"] = e.noise_floor_object_err;
+    out.record["noise_floor_edge_err"] = e.noise_floor_edge_err;
+    out.record["noise_floor_shadow_err"] = e.noise_floor_shadow_err;
+    out.record["composite_frames"] = e.frames;
+  }
   return out;
 }
 
@@ -204,6 +269,8 @@ void register_regress(CLI::App& app) {
   cmd->add_flag("--allow-incomplete", o->allow_incomplete,
                 "Accept recordings that were never closed (killed or crashed)");
   cmd->add_flag("--no-cache", o->no_cache, "Build the irradiance volume without reading or writing the cache");
+  cmd->add_flag("--json", o->json,
+                "Print one JSON object per recording on stdout (keys: docs/ground_truth.md); the lines go to stderr");
   cmd->add_flag("--update", o->update,
                 "Write new golden frames and expected.json instead of comparing (thresholds: docs/formats.md, "
                 "\"Regression expectations\")");
@@ -219,11 +286,16 @@ void register_regress(CLI::App& app) {
     int passed = 0, failed = 0;
     for (const auto& dir : dirs) {
       const Outcome r = regress_one(dir, *o);
-      std::printf("%s\n", r.line.c_str());
+      if (o->json) {
+        std::fprintf(stderr, "%s\n", r.line.c_str());
+        std::printf("%s\n", r.record.dump().c_str());
+      } else {
+        std::printf("%s\n", r.line.c_str());
+      }
       std::fflush(stdout);
       (r.pass ? passed : failed)++;
     }
-    std::printf("regress: %d passed, %d failed\n", passed, failed);
+    std::fprintf(o->json ? stderr : stdout, "regress: %d passed, %d failed\n", passed, failed);
     if (failed > 0) throw RuntimeError(fmt::format("{} of {} recordings failed regression", failed, dirs.size()));
   });
 }

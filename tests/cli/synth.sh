@@ -36,10 +36,31 @@ case_truth_beside_the_video() {
   "$LUMAR" synth --scene "$SCENE" --camera "$CAM" --out "$TMP/rec" --frames 2 --supersample 1 --truth \
     >"$TMP/log" 2>&1 || { cat "$TMP/log"; fail "synth --truth failed"; }
   local kind
-  for kind in frame other-seed mask; do
+  for kind in frame other-seed empty mask; do
     [ "$(ls "$TMP/rec/truth/$kind"-*.png | wc -l)" -eq 2 ] || fail "expected 2 truth/$kind-*.png"
   done
   cmp -s "$TMP/rec/truth/frame-00000.png" "$TMP/rec/truth/other-seed-00000.png" && fail "the two seeds agree"
+  # regress measures the composite against it: one JSON object, every key of the measure,
+  # the noise floors between 0.1 and 5 %, the composite's errors above their floors.
+  "$LUMAR" regress --update "$TMP/rec" >"$TMP/log" 2>&1 || { cat "$TMP/log"; fail "regress --update failed"; }
+  "$LUMAR" regress --json "$TMP/rec" >"$TMP/json" 2>"$TMP/err" || { cat "$TMP/err"; fail "regress --json failed"; }
+  cat "$TMP/err"
+  [ "$(wc -l <"$TMP/json")" -eq 1 ] || fail "expected one JSON line on stdout"
+  grep -q "composite vs truth" "$TMP/err" || fail "no measure on stderr"
+  python3 - "$TMP/json" <<'PY' || fail "the measure's JSON"
+import json, sys
+r = json.load(open(sys.argv[1]))
+keys = ["recording", "object_err", "edge_err", "shadow_err", "noise_ratio",
+        "noise_floor_object_err", "noise_floor_edge_err", "noise_floor_shadow_err"]
+missing = [k for k in keys if r.get(k) is None]
+assert not missing, "missing: %s" % missing
+for region in ("object", "edge", "shadow"):
+    floor, err = r["noise_floor_%s_err" % region], r["%s_err" % region]
+    assert 0.1 < floor < 5, "%s floor %s" % (region, floor)
+    assert floor < err < 50, "%s error %s (floor %s)" % (region, err, floor)
+assert 0.2 < r["noise_ratio"] < 5, r["noise_ratio"]
+print("ok:", {k: round(r[k], 2) for k in keys[1:]})
+PY
   # The same scene without its figurine, its files named by absolute paths.
   python3 - "$SCENE" "$TMP/empty.json" <<'PY'
 import json, os, sys

@@ -246,22 +246,24 @@ void synthesize_recording(const SynthSettings& s) {
       s.out, session, tracker, video, s.frames, s.seed, [&](int k) { return start + frame_period * k; }, true_camera,
       [&](int k, Nanos, const Pose& T_world_camera, cv::RNG& rng) {
         const cv::Mat radiance = renderer.render_room_radiance(pinhole, T_world_camera);
+        // The video's own noise, drawn again for the truth, so that only the objects differ.
+        cv::RNG same_noise = rng;
+        const cv::Mat video = expose(calib::distort_image(radiance, pinhole, s.camera), s.camera, s, exposure, rng);
         if (truth) {
-          // The video's own noise, drawn again for the truth, so that only the objects differ.
-          cv::RNG same_noise = rng;
           const TruthFrame frame = render_truth_frame(*truth, pinhole, T_world_camera, radiance, truth_settings);
           const cv::Mat seen = calib::distort_image(frame.radiance, pinhole, s.camera);
           const std::filesystem::path dir = s.out / "truth";
           std::filesystem::create_directories(dir);
-          calib::write_image_atomically(dir / fmt::format("frame-{:05d}.png", k),
-                                        expose(seen, s.camera, s, exposure, same_noise));
-          calib::write_image_atomically(dir / fmt::format("other-seed-{:05d}.png", k),
-                                        expose(seen, s.camera, s, exposure, other_seed));
+          const auto file = [&](const char* kind) { return dir / fmt::format("{}-{:05d}.png", kind, k); };
+          calib::write_image_atomically(file("frame"), expose(seen, s.camera, s, exposure, same_noise));
+          calib::write_image_atomically(file("other-seed"), expose(seen, s.camera, s, exposure, other_seed));
+          // The empty room as the sensor saw it, before the video's compression.
+          calib::write_image_atomically(file("empty"), video);
           cv::Mat mask;
           cv::compare(calib::distort_image(frame.coverage, pinhole, s.camera), 0.5, mask, cv::CMP_GT);
-          calib::write_image_atomically(dir / fmt::format("mask-{:05d}.png", k), mask);
+          calib::write_image_atomically(file("mask"), mask);
         }
-        return expose(calib::distort_image(radiance, pinhole, s.camera), s.camera, s, exposure, rng);
+        return video;
       });
   spdlog::info("synth: wrote {} ({} frames, exposure {:.4g}, tracker {} records)", s.out.string(), s.frames, exposure,
                tracker.noisy_samples.size());
