@@ -16,6 +16,8 @@ std::filesystem::path source_dir() { return LUMAR_SOURCE_DIR; }
 std::filesystem::path shared_dir() { return LUMAR_SHARED_DIR; }
 std::filesystem::path lumar_binary() { return LUMAR_BINARY; }
 
+int time_scale() { return LUMAR_TEST_TIME_SCALE; }
+
 std::vector<std::filesystem::path> checkerboard_images() {
   std::vector<std::filesystem::path> images;
   for (const auto& entry : std::filesystem::directory_iterator(shared_dir() / "data/calib/checkerboard-9x6"))

@@ -11,6 +11,9 @@ std::filesystem::path shared_dir();
 std::filesystem::path lumar_binary();
 // The 13 shared photographs of the 9x6 checkerboard, sorted by name.
 std::vector<std::filesystem::path> checkerboard_images();
+// How many times slower this build runs than a release build (8 under ThreadSanitizer, 3
+// under ASan + UBSan, else 1; tests/CMakeLists.txt), for the few limits a test times itself.
+int time_scale();
 // A fresh, empty directory for this test; removed by the caller if wanted.
 std::filesystem::path scratch_dir(const std::string& name);
 

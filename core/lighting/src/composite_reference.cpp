@@ -51,34 +51,48 @@ CompositeReference::~CompositeReference() = default;
 
 std::optional<ObjectHit> CompositeReference::hit_object(const glm::dvec3& origin, const glm::dvec3& direction,
                                                         double t_far) const {
-  Ray ray;
-  ray.origin = glm::vec3(origin);
-  ray.direction = glm::vec3(direction);
-  ray.t_far = float(std::min(t_far, 1e30));
-  const auto hit = rays_->intersect(ray);
-  if (!hit) return std::nullopt;
-  ObjectHit h;
-  h.object = int(hit->mesh);
-  h.t = hit->t;
-  h.triangle = hit->triangle;
-  h.point = origin + direction * double(hit->t);
-  h.facing = glm::dvec3(hit->normal);
-  // Barycentric weights of the hit point in its triangle, for the vertex normals.
-  const Mesh& m = objects_[std::size_t(h.object)].world;
-  const glm::dvec3 a = vertex(m, h.triangle, 0), b = vertex(m, h.triangle, 1), c = vertex(m, h.triangle, 2);
-  const glm::dvec3 n = glm::cross(b - a, c - a);
-  const double area2 = glm::dot(n, n);
-  if (area2 > 0) {
-    const double wb = glm::dot(glm::cross(h.point - a, c - a), n) / area2;
-    const double wc = glm::dot(glm::cross(b - a, h.point - a), n) / area2;
-    h.weights = glm::clamp(glm::dvec3(1.0 - wb - wc, wb, wc), 0.0, 1.0);
-  } else {
-    h.weights = glm::dvec3(1.0 / 3.0);
-  }
-  glm::dvec3 shading(0.0);
-  for (int k = 0; k < 3; ++k) shading += h.weights[k] * glm::dvec3(m.normals[m.indices[3 * h.triangle + k]]);
-  h.normal = glm::dot(shading, shading) > 0 ? glm::normalize(shading) : h.facing;
-  return h;
+  const glm::dvec3 forward = glm::normalize(direction);
+  const auto cast = [&](const glm::dvec3& w) -> std::optional<ObjectHit> {
+    Ray ray;
+    ray.origin = glm::vec3(origin);
+    ray.direction = glm::vec3(w);
+    ray.t_far = float(std::min(t_far, 1e30));
+    const auto hit = rays_->intersect(ray);
+    if (!hit) return std::nullopt;
+    ObjectHit h;
+    h.object = int(hit->mesh);
+    h.t = hit->t;
+    h.triangle = hit->triangle;
+    h.point = origin + w * double(hit->t);
+    h.facing = glm::dvec3(hit->normal);
+    // Barycentric weights of the hit point in its triangle, for the vertex normals.
+    const Mesh& m = objects_[std::size_t(h.object)].world;
+    const glm::dvec3 a = vertex(m, h.triangle, 0), b = vertex(m, h.triangle, 1), c = vertex(m, h.triangle, 2);
+    const glm::dvec3 n = glm::cross(b - a, c - a);
+    const double area2 = glm::dot(n, n);
+    if (area2 > 0) {
+      const double wb = glm::dot(glm::cross(h.point - a, c - a), n) / area2;
+      const double wc = glm::dot(glm::cross(b - a, h.point - a), n) / area2;
+      h.weights = glm::clamp(glm::dvec3(1.0 - wb - wc, wb, wc), 0.0, 1.0);
+    } else {
+      h.weights = glm::dvec3(1.0 / 3.0);
+    }
+    glm::dvec3 shading(0.0);
+    for (int k = 0; k < 3; ++k) shading += h.weights[k] * glm::dvec3(m.normals[m.indices[3 * h.triangle + k]]);
+    h.normal = glm::dot(shading, shading) > 0 ? glm::normalize(shading) : h.facing;
+    return h;
+  };
+  // Every ray starts outside the objects, so meeting a surface from inside (its vertex
+  // normals turned away from the ray's origin, whatever the winding) means the ray slipped
+  // through a crack between two triangles: Embree is not watertight by default, and rays
+  // along a UV sphere's meridian edges do it. Nudge the ray and cast it again.
+  const auto from_inside = [&](const ObjectHit& h) { return glm::dot(h.facing, h.normal) < 0.0; };
+  auto hit = cast(forward);
+  glm::dvec3 side, up;
+  orthonormal_basis(forward, side, up);
+  for (int attempt = 1; hit && from_inside(*hit) && attempt <= 4; ++attempt)
+    hit = cast(glm::normalize(forward + (attempt % 2 ? side : up) * (attempt <= 2 ? 1e-5 : -1e-5)));
+  return hit;
 }
 
 bool CompositeReference::blocked(const glm::dvec3& p, const glm::dvec3& w, double t_far) const {

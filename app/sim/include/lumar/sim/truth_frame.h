@@ -15,9 +15,9 @@ struct TruthSettings {
   // The room's ratio is sampled every `ratio_stride` pixels and interpolated between
   // (it is smooth but for contact shadows; 1 = every pixel).
   int ratio_stride = 4;
-  // Each object pixel integrates its own E; false: its vertices' E, interpolated (on a
-  // mesh as fine as the pixels, nearly the same at a small part of the cost).
-  bool per_pixel_objects = false;
+  // Each object pixel integrates its own E; false: its vertices' E, interpolated (a
+  // fraction of the cost, but 5.6 % off on the figurine, against 2.3 % of ray noise).
+  bool per_pixel_objects = true;
 };
 
 struct TruthFrame {
