@@ -113,8 +113,11 @@ glm::dvec3 CompositeReference::object_radiance(const ObjectHit& hit, bool per_po
   const Object& object = objects_[std::size_t(hit.object)];
   glm::dvec3 E(0.0);
   if (per_point || object.vertex_irradiance.empty()) {
+    // Seen from inside (through a hole in a scanned shell: the figurine's crest, arm and
+    // toes), the vertex normals face away: the surface's own normal, towards the viewer.
+    const glm::dvec3 n = glm::dot(hit.normal, hit.facing) > 0.0 ? hit.normal : hit.facing;
     E = reference_irradiance(
-        room_, hit.point, hit.normal, hit.facing, settings_.object_strata,
+        room_, hit.point, n, hit.facing, settings_.object_strata,
         [this](const glm::dvec3& q, const glm::dvec3& w, double t_far) { return blocked(q, w, t_far); });
   } else {
     const Mesh& m = object.world;
