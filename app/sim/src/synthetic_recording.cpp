@@ -253,7 +253,7 @@ void synthesize_recording(const SynthSettings& s) {
           const TruthFrame frame = render_truth_frame(*truth, pinhole, T_world_camera, radiance, truth_settings);
           const cv::Mat seen = calib::distort_image(frame.radiance, pinhole, s.camera);
           const std::filesystem::path dir = s.out / "truth";
-          std::filesystem::create_directories(dir);
+          if (k == 0) std::filesystem::create_directories(dir);
           const auto file = [&](const char* kind) { return dir / fmt::format("{}-{:05d}.png", kind, k); };
           calib::write_image_atomically(file("frame"), expose(seen, s.camera, s, exposure, same_noise));
           calib::write_image_atomically(file("other-seed"), expose(seen, s.camera, s, exposure, other_seed));

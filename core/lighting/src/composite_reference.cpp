@@ -95,6 +95,10 @@ std::optional<ObjectHit> CompositeReference::hit_object(const glm::dvec3& origin
   return hit;
 }
 
+ExtraOccluder CompositeReference::objects_as_occluder() const {
+  return [this](const glm::dvec3& q, const glm::dvec3& w, double t_far) { return blocked(q, w, t_far); };
+}
+
 bool CompositeReference::blocked(const glm::dvec3& p, const glm::dvec3& w, double t_far) const {
   Ray ray;
   ray.origin = glm::vec3(p);
@@ -104,9 +108,7 @@ bool CompositeReference::blocked(const glm::dvec3& p, const glm::dvec3& w, doubl
 }
 
 glm::dvec3 CompositeReference::irradiance_with_objects(const glm::dvec3& p, const glm::dvec3& n, int strata) const {
-  return reference_irradiance(
-      room_, p, n, n, strata > 0 ? strata : settings_.object_strata,
-      [this](const glm::dvec3& q, const glm::dvec3& w, double t_far) { return blocked(q, w, t_far); });
+  return reference_irradiance(room_, p, n, n, strata > 0 ? strata : settings_.object_strata, objects_as_occluder());
 }
 
 glm::dvec3 CompositeReference::object_radiance(const ObjectHit& hit, bool per_point) const {
@@ -116,9 +118,7 @@ glm::dvec3 CompositeReference::object_radiance(const ObjectHit& hit, bool per_po
     // Seen from inside (through a hole in a scanned shell: the figurine's crest, arm and
     // toes), the vertex normals face away: the surface's own normal, towards the viewer.
     const glm::dvec3 n = glm::dot(hit.normal, hit.facing) > 0.0 ? hit.normal : hit.facing;
-    E = reference_irradiance(
-        room_, hit.point, n, hit.facing, settings_.object_strata,
-        [this](const glm::dvec3& q, const glm::dvec3& w, double t_far) { return blocked(q, w, t_far); });
+    E = reference_irradiance(room_, hit.point, n, hit.facing, settings_.object_strata, objects_as_occluder());
   } else {
     const Mesh& m = object.world;
     for (int k = 0; k < 3; ++k) E += hit.weights[k] * object.vertex_irradiance[m.indices[3 * hit.triangle + k]];

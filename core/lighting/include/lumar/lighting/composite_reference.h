@@ -17,6 +17,7 @@
 #include <span>
 #include <vector>
 
+#include "lumar/lighting/irradiance_reference.h"
 #include "lumar/lighting/ray_scene.h"
 #include "lumar/lighting/room_radiance.h"
 #include "lumar/scene/loaded_scene.h"
@@ -78,6 +79,8 @@ class CompositeReference {
   };
   // Whether an object lies on the segment p + t·w, t in (0, t_far).
   bool blocked(const glm::dvec3& p, const glm::dvec3& w, double t_far) const;
+  // `blocked` in the form reference_irradiance takes.
+  ExtraOccluder objects_as_occluder() const;
 
   const RoomRadiance& room_;
   CompositeReferenceSettings settings_;
