@@ -20,7 +20,8 @@ namespace {
 
 struct OverlayOptions {
   std::string recording, scene, out, frames_dir, contact_sheet, poses = "tracker", undistort = "same";
-  std::string filter = "none";
+  std::string filter = "none", without;
+  double blur_sigma = -1.0;
   bool window = false, no_cache = false, allow_incomplete = false;
   int max_frames = 0;
   int adapt_lighting = 0;
@@ -35,6 +36,7 @@ pipeline::OverlaySettings overlay_settings(const OverlayOptions& o, bool window)
   s.adapt_lighting_every = o.adapt_lighting;
   s.window = window;
   s.volume_cache = !o.no_cache;
+  apply_composite_features(o.without, o.blur_sigma, s);
   return s;
 }
 
@@ -156,6 +158,7 @@ void register_overlay(CLI::App& app) {
   cmd->add_flag("--allow-incomplete", o->allow_incomplete,
                 "Replay a recording that was never closed (killed or crashed): its closed frames");
   cmd->add_option("--max-frames", o->max_frames, "Stop after this many frames (0 = all)")->capture_default_str();
+  add_composite_feature_options(cmd, o->without, o->blur_sigma);
   cmd->add_flag("--no-cache", o->no_cache,
                 "Build the irradiance volume without reading or writing the cache ($XDG_CACHE_HOME/lumar)");
   // The live path (pipeline/live_overlay.h): --source and --tracker instead of --recording.

@@ -31,6 +31,8 @@ struct RegressOptions {
   std::string root = "recordings";
   std::string scene;  // instead of the one the session names (a live recording names none)
   bool update = false, no_cache = false, allow_incomplete = false, json = false;
+  std::string without;  // the composite features switched off (commands.h)
+  double blur_sigma = -1.0;
 };
 
 const cv::Size kGoldenSize(160, 120);
@@ -83,10 +85,12 @@ struct Outcome {
 
 // The composite against truth/ (docs/ground_truth.md), replayed with the true poses so
 // that registration is not part of the measure; nothing when the recording has no truth.
-std::optional<pipeline::CompositeError> composite_error(const fs::path& dir, const RegressOptions& o) {
+std::optional<pipeline::CompositeError> composite_error(const fs::path& dir, const RegressOptions& o,
+                                                        const std::string& without) {
   const fs::path truth = dir / "truth";
   if (!fs::is_directory(truth)) return std::nullopt;
   pipeline::ReplayOverlaySettings settings;
+  apply_composite_features(without, o.blur_sigma, settings.overlay);
   settings.scene = o.scene;
   settings.poses = pipeline::PoseSource::Truth;
   settings.overlay.volume_cache = !o.no_cache;
@@ -130,6 +134,7 @@ Outcome regress_one(const fs::path& dir, const RegressOptions& o) {
 
   pipeline::ReplayOverlaySettings settings;
   settings.scene = o.scene;
+  apply_composite_features(o.without, o.blur_sigma, settings.overlay);
   settings.overlay.volume_cache = !o.no_cache;
   settings.allow_incomplete = o.allow_incomplete;
   pipeline::ReplayOverlay overlay(dir, settings);
@@ -217,7 +222,9 @@ Outcome regress_one(const fs::path& dir, const RegressOptions& o) {
   const double psnr_limit = expected.at("psnr_min_db").get<double>();
   const double tracked_limit = expected.at("tracked_projection_mean_px_max").get<double>();
   const double render_limit = expected.at("render_projection_mean_px_max").get<double>();
-  const auto measured = composite_error(dir, o);
+  const auto measured = composite_error(dir, o, o.without);
+  // The same composite with every feature that closes the gap off: what they bring.
+  const auto all_off = measured ? composite_error(dir, o, "all") : std::nullopt;
   Outcome out;
   out.pass = (update || psnr_min >= psnr_limit) && tracked_mean <= tracked_limit && render_error <= render_limit &&
              render_samples > 0 && tracked_errors.size() == frames.size();
@@ -237,7 +244,8 @@ Outcome regress_one(const fs::path& dir, const RegressOptions& o) {
                 {"tracked_projection_mean_px", tracked_mean},
                 {"render_projection_mean_px", render_error}};
   for (const char* key : {"object_err", "edge_err", "shadow_err", "noise_ratio", "noise_floor_object_err",
-                          "noise_floor_edge_err", "noise_floor_shadow_err"})
+                          "noise_floor_edge_err", "noise_floor_shadow_err", "all_off_object_err", "all_off_edge_err",
+                          "all_off_shadow_err", "all_off_noise_ratio"})
     out.record[key] = nullptr;
   if (measured) {
     const pipeline::CompositeError& e = *measured;
@@ -246,6 +254,14 @@ Outcome regress_one(const fs::path& dir, const RegressOptions& o) {
         "edge {:.2f} % ({:.2f} %), shadow {:.2f} % ({:.2f} %) over {} / {} / {} pixels; noise ratio {:.2f}",
         e.frames, e.object_err, e.noise_floor_object_err, e.edge_err, e.noise_floor_edge_err, e.shadow_err,
         e.noise_floor_shadow_err, e.pixels[0], e.pixels[1], e.pixels[2], e.noise_ratio);
+    const pipeline::CompositeError& off = *all_off;
+    out.line += fmt::format(
+        "\n  the same with --without all: object {:.2f} %, edge {:.2f} %, shadow {:.2f} %; noise ratio {:.2f}",
+        off.object_err, off.edge_err, off.shadow_err, off.noise_ratio);
+    out.record["all_off_object_err"] = off.object_err;
+    out.record["all_off_edge_err"] = off.edge_err;
+    out.record["all_off_shadow_err"] = off.shadow_err;
+    out.record["all_off_noise_ratio"] = off.noise_ratio;
     out.record["object_err"] = e.object_err;
     out.record["edge_err"] = e.edge_err;
     out.record["shadow_err"] = e.shadow_err;
@@ -271,6 +287,7 @@ void register_regress(CLI::App& app) {
   cmd->add_flag("--no-cache", o->no_cache, "Build the irradiance volume without reading or writing the cache");
   cmd->add_flag("--json", o->json,
                 "Print one JSON object per recording on stdout (keys: docs/ground_truth.md); the lines go to stderr");
+  add_composite_feature_options(cmd, o->without, o->blur_sigma);
   cmd->add_flag("--update", o->update,
                 "Write new golden frames and expected.json instead of comparing (thresholds: docs/formats.md, "
                 "\"Regression expectations\")");

@@ -14,6 +14,36 @@ std::map<CLI::App*, std::function<void()>>& actions() {
 
 void add_action(CLI::App* sub, std::function<void()> run) { actions()[sub] = std::move(run); }
 
+void add_composite_feature_options(CLI::App* cmd, std::string& without, double& blur_sigma_px) {
+  cmd->add_option("--without", without,
+                  "Switch off what makes the objects look like the camera's pixels: a comma-separated list of "
+                  "antialiasing, self-occlusion, noise, blur, or all (docs/ground_truth.md)");
+  cmd->add_option("--blur-sigma", blur_sigma_px,
+                  "The camera's blur as a Gaussian of this many output pixels (default: estimated from the video)")
+      ->check(CLI::Range(0.0, 4.0));
+}
+
+void apply_composite_features(const std::string& without, double blur_sigma_px, pipeline::OverlaySettings& settings) {
+  gl::CompositeFeatures& f = settings.features;
+  std::stringstream list(without);
+  for (std::string name; std::getline(list, name, ',');) {
+    if (name == "antialiasing")
+      f.antialiasing = false;
+    else if (name == "self-occlusion")
+      f.self_occlusion = false;
+    else if (name == "noise")
+      f.noise = false;
+    else if (name == "blur")
+      f.blur = false;
+    else if (name == "all")
+      f = gl::CompositeFeatures{false, false, false, false};
+    else
+      throw InputError("--without " + without + ": unknown feature '" + name +
+                       "'; use antialiasing, self-occlusion, noise, blur or all");
+  }
+  if (blur_sigma_px >= 0) settings.blur_sigma_px = blur_sigma_px;
+}
+
 void add_live_input_options(CLI::App* cmd, pipeline::LiveInputOptions& o, const std::string& camera_help) {
   cmd->add_option("--timestamps", o.timestamps, "images: a file,time_ns table of the frames");
   cmd->add_option("--images-fps", o.images_fps, "images: fixed frame rate when there is no table");

@@ -6,6 +6,7 @@
 #include <string>
 
 #include "lumar/pipeline/live_inputs.h"
+#include "lumar/pipeline/overlay.h"
 
 namespace lumar::app {
 
@@ -18,6 +19,12 @@ void add_action(CLI::App* subcommand, std::function<void()> run);
 void add_live_input_options(
     CLI::App* cmd, pipeline::LiveInputOptions& o,
     const std::string& camera_help = "Camera calibration (OpenCV YAML); default: a nominal pinhole");
+
+// --without and --blur-sigma: what makes rendered pixels look like the camera's
+// (gl::CompositeFeatures), with the same names in every command that composites.
+void add_composite_feature_options(CLI::App* cmd, std::string& without, double& blur_sigma_px);
+// Applies them to `settings`; InputError names an unknown feature.
+void apply_composite_features(const std::string& without, double blur_sigma_px, pipeline::OverlaySettings& settings);
 
 void register_synth(CLI::App& app);
 void register_overlay(CLI::App& app);

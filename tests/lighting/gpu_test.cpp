@@ -105,6 +105,7 @@ TEST(IrradianceGpu, ShaderMatchesTheCpuEvaluationAtTheSameWorldPoints) {
     const IrradianceVolume v = IrradianceVolume::build(radiance, room.box_min, room.box_max, s);
     const CameraIntrinsics cam = camera(120, 90, 110);
     gl::Renderer r(cam);
+    r.set_features({.antialiasing = false});  // each pixel its one point's shading
     const int id = r.add_object(sphere(0.3f, 64, 32));
     const glm::vec3 albedo(0.8f, 0.7f, 0.6f);
     r.set_object_material(id, albedo, SH9{});
@@ -132,6 +133,7 @@ TEST(IrradianceGpu, CompositorShadingFollowsTheObjectThroughTheSampleRoom) {
   std::printf("sample room volume: %d probes, %d refined cells, %.0f ms to build\n", v->stats().probes,
               v->stats().refined_cells, v->stats().build_ms);
   gl::Renderer& r = compositor.renderer();
+  r.set_features({.antialiasing = false});  // each pixel its one point's shading
   const int id = r.add_object(sphere(0.15f, 48, 24));
   const glm::vec3 albedo(0.6f);
   r.set_object_material(id, albedo, SH9{});

@@ -5,7 +5,11 @@
 #include <chrono>
 #include <cstdlib>
 
+#include <spdlog/spdlog.h>
+
 #include "lumar/base/error.h"
+#include "lumar/calib/camera_blur.h"
+#include "lumar/calib/sensor_noise.h"
 
 namespace lumar::pipeline {
 
@@ -15,8 +19,8 @@ double ms_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 }
 
-gl::VideoRadiometry video_radiometry(const capture::Radiometry& radiometry, const CameraIntrinsics& camera,
-                                     const std::optional<calib::CameraResponse>& response) {
+gl::VideoRadiometry renderer_radiometry(const capture::Radiometry& radiometry, const CameraIntrinsics& camera,
+                                        const std::optional<calib::CameraResponse>& response) {
   gl::VideoRadiometry out;
   out.video_camera = camera;
   out.vignetting_a = radiometry.vignetting_a;
@@ -43,13 +47,58 @@ Overlay::Overlay(std::shared_ptr<const LoadedScene> scene, const CameraIntrinsic
   } else {
     context_ = gl::create_headless_context();
   }
-  const calib::UndistortionMaps maps = calib::make_undistortion_maps(camera, settings.undistortion);
+  maps_ = calib::make_undistortion_maps(camera, settings.undistortion);
+  const calib::UndistortionMaps& maps = maps_;
   compositor_ =
       std::make_unique<Compositor>(std::move(scene), maps.output, maps.map_x, maps.map_y, settings.volume_cache);
-  compositor_->renderer().set_video_radiometry(video_radiometry(radiometry, camera, response));
+  // The renderer's linear unit is the response's (sRGB with gain 1 without one).
+  response_ = response.value_or(calib::srgb_response(1.0));
+  radiometry_ = renderer_radiometry(radiometry, camera, response);
+  features_ = settings.features;
+  noise_known_ = !features_.noise;
+  blur_known_ = !features_.blur;
+  if (settings.blur_sigma_px >= 0) radiometry_.blur_sigma_px = settings.blur_sigma_px, blur_known_ = true;
+  compositor_->set_features(features_);
+  compositor_->renderer().set_video_radiometry(radiometry_);
   if (settings.adapt_lighting_every > 0)
-    live_lighting_.emplace(camera, maps, response.value_or(calib::srgb_response(1.0)), radiometry,
-                           settings.adapt_lighting_every);
+    live_lighting_.emplace(camera, maps, response_, radiometry, settings.adapt_lighting_every);
+}
+
+// The first frame, and every kRetry-th until both are known (a camera may start on a
+// blank wall): the sensor's noise from the frame's flat patches, the blur from its
+// sharpest edges in the undistorted image the composite shows.
+void Overlay::measure_camera(const cv::Mat& video) {
+  constexpr std::int64_t kRetry = 30;
+  if ((noise_known_ && blur_known_) || frames_seen_++ % kRetry != 0) return;
+  std::string failed;
+  if (!noise_known_) try {
+      const calib::SensorNoise noise = calib::estimate_sensor_noise({video}, response_);
+      for (int c = 0; c < 3; ++c) {
+        radiometry_.noise_read_variance[std::size_t(c)] = float(noise.read_variance[std::size_t(c)]);
+        radiometry_.noise_shot_gain[std::size_t(c)] = float(noise.shot_gain[std::size_t(c)]);
+      }
+      noise_known_ = true;
+      spdlog::debug("camera noise: sigma {:.4f} (B) {:.4f} (G) {:.4f} (R) at linear 0.18, from {} flat patches",
+                    noise.sigma(0, 0.18), noise.sigma(1, 0.18), noise.sigma(2, 0.18), noise.patches);
+    } catch (const InputError& e) {
+      failed += std::string(e.what()) + "; ";
+    }
+  if (!blur_known_) try {
+      const calib::CameraBlur blur = calib::estimate_camera_blur(calib::undistort_image(video, maps_));
+      // Antialiasing already averages each pixel's area, a box of variance 1/12 px².
+      const double box = features_.antialiasing ? 1.0 / 12.0 : 0.0;
+      radiometry_.blur_sigma_px = std::min(4.0, std::sqrt(std::max(0.0, blur.sigma_px * blur.sigma_px - box)));
+      blur_known_ = true;
+      spdlog::debug("camera blur: sigma {:.2f} px from {} edge pixels", blur.sigma_px, blur.edges);
+    } catch (const InputError& e) {
+      failed += std::string(e.what()) + "; ";
+    }
+  if (!failed.empty() && !warned_) {
+    spdlog::warn("overlay: the camera's noise or blur cannot be measured yet, trying again every {} frames: {}", kRetry,
+                 failed.substr(0, failed.size() - 2));
+    warned_ = true;
+  }
+  compositor_->renderer().set_video_radiometry(radiometry_);
 }
 
 Overlay::~Overlay() {
@@ -64,6 +113,7 @@ OverlayFrame Overlay::composite(const capture::Frame& frame, const std::optional
   out.video = frame.image;
   out.T_world_camera = T_world_camera;
   if (!T_world_camera) ++frames_without_pose_;
+  measure_camera(frame.image);
   if (live_lighting_ && T_world_camera) {
     const auto t0 = std::chrono::steady_clock::now();
     out.lighting_scale = live_lighting_->update(compositor_->renderer(), frame.image, *T_world_camera, frame.time);
@@ -76,6 +126,7 @@ OverlayFrame Overlay::composite(const capture::Frame& frame, const std::optional
   times_.background += gt.background_ms;
   times_.depth += gt.depth_ms;
   times_.objects += gt.objects_ms;
+  times_.blur += gt.blur_ms;
   times_.readback += gt.readback_ms;
   ++times_.frames;
   return out;
@@ -90,6 +141,7 @@ std::string format_stage_times(const StageTimes& t) {
                                                    {"background (undistort)", t.background},
                                                    {"proxy depth", t.depth},
                                                    {"virtual objects", t.objects},
+                                                   {"camera blur", t.blur},
                                                    {"read back", t.readback},
                                                    {"encode output", t.output}};
   double total = 0;

@@ -4,6 +4,7 @@
 #include <spdlog/spdlog.h>
 #include <cmath>
 #include <opencv2/calib3d.hpp>
+#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "lumar/base/color.h"
@@ -127,6 +128,16 @@ cv::Mat expose(const cv::Mat& radiance_bgr, const CameraIntrinsics& camera, cons
   sensor.vignetting_a = s.vignetting_a;
   sensor.vignetting_b = s.vignetting_b;
   return expose_8bit(radiance_bgr, camera, sensor, exposure, rng);
+}
+
+// The video codec's loss, for frames stored apart from the video (the truth): a JPEG
+// of the same quality for MJPEG (OpenCV's MJPEG writer is its own JPEG encoder, so the
+// loss is alike, not the same bits), nothing for the lossless FFV1.
+cv::Mat compress_like_video(const cv::Mat& frame, const SynthSettings& s) {
+  if (s.codec != "mjpeg") return frame;
+  std::vector<std::uint8_t> bytes;
+  cv::imencode(".jpg", frame, bytes, {cv::IMWRITE_JPEG_QUALITY, s.quality});
+  return cv::imdecode(bytes, cv::IMREAD_COLOR);
 }
 
 // Where the camera looks: the foot of the first virtual object (the centre of its
@@ -255,10 +266,13 @@ void synthesize_recording(const SynthSettings& s) {
           const std::filesystem::path dir = s.out / "truth";
           if (k == 0) std::filesystem::create_directories(dir);
           const auto file = [&](const char* kind) { return dir / fmt::format("{}-{:05d}.png", kind, k); };
-          calib::write_image_atomically(file("frame"), expose(seen, s.camera, s, exposure, same_noise));
-          calib::write_image_atomically(file("other-seed"), expose(seen, s.camera, s, exposure, other_seed));
-          // The empty room as the sensor saw it, before the video's compression.
-          calib::write_image_atomically(file("empty"), video);
+          calib::write_image_atomically(file("frame"),
+                                        compress_like_video(expose(seen, s.camera, s, exposure, same_noise), s));
+          calib::write_image_atomically(file("other-seed"),
+                                        compress_like_video(expose(seen, s.camera, s, exposure, other_seed), s));
+          // The empty room through the same JPEG encoder as the truth: where the objects
+          // change nothing the two are the same bits, so a codec's loss is not taken for a shadow.
+          calib::write_image_atomically(file("empty"), compress_like_video(video, s));
           cv::Mat mask;
           cv::compare(calib::distort_image(frame.coverage, pinhole, s.camera), 0.5, mask, cv::CMP_GT);
           calib::write_image_atomically(file("mask"), mask);

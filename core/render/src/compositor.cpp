@@ -2,8 +2,11 @@
 
 #include <spdlog/spdlog.h>
 
+#include <chrono>
+
 #include "lumar/lighting/irradiance_scene.h"
 #include "lumar/lighting/irradiance_volume.h"
+#include "lumar/lighting/self_occlusion.h"
 #include "lumar/lighting/shadows/object_shadows.h"
 #include "lumar/lighting/shadows/shadow_methods.h"
 #include "lumar/lighting/shadows/shadow_occlusion.h"
@@ -40,6 +43,22 @@ Compositor::Compositor(std::shared_ptr<const LoadedScene> scene, const CameraInt
     spdlog::debug("object '{}': {} triangles", object.name, mesh.triangle_count());
   }
   build_shadows();
+  set_features(renderer_->features());
+}
+
+void Compositor::bake_self_occlusion_once() {
+  if (self_occlusion_baked_) return;
+  self_occlusion_baked_ = true;
+  const auto t0 = std::chrono::steady_clock::now();
+  for (std::size_t i = 0; i < scene_->objects.size(); ++i)
+    renderer_->set_object_self_occlusion(int(i), bake_self_occlusion(scene_->objects[i].model));
+  spdlog::debug("self-occlusion baked in {:.0f} ms",
+                std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+}
+
+void Compositor::set_features(const gl::CompositeFeatures& features) {
+  if (features.self_occlusion) bake_self_occlusion_once();
+  renderer_->set_features(features);
 }
 
 // Precomputes the shadow lines from the scene's receivers to its emitters (the objects

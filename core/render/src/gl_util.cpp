@@ -86,9 +86,9 @@ GlName create_buffer(const void* data, std::size_t bytes, GLbitfield flags) {
   return buffer;
 }
 
-void attach_vec3_attribute(GLuint vertex_array, GLuint attribute, GLuint buffer) {
-  glVertexArrayVertexBuffer(vertex_array, attribute, buffer, 0, sizeof(float) * 3);
-  glVertexArrayAttribFormat(vertex_array, attribute, 3, GL_FLOAT, GL_FALSE, 0);
+void attach_float_attribute(GLuint vertex_array, GLuint attribute, GLuint buffer, int components) {
+  glVertexArrayVertexBuffer(vertex_array, attribute, buffer, 0, GLsizei(sizeof(float)) * components);
+  glVertexArrayAttribFormat(vertex_array, attribute, components, GL_FLOAT, GL_FALSE, 0);
   glVertexArrayAttribBinding(vertex_array, attribute, attribute);
   glEnableVertexArrayAttrib(vertex_array, attribute);
 }

@@ -45,9 +45,9 @@ GlName create_texture_2d(GLenum internal_format, int width, int height, GLenum f
 GlName create_buffer(const void* data, std::size_t bytes, GLbitfield flags = 0);
 GlName create_framebuffer();
 GlName create_vertex_array();
-// Feeds vertex attribute `attribute` of `vertex_array` from a tightly packed vec3 buffer
-// (binding point = attribute index).
-void attach_vec3_attribute(GLuint vertex_array, GLuint attribute, GLuint buffer);
+// Feeds vertex attribute `attribute` of `vertex_array` from a tightly packed buffer of
+// `components` floats per vertex (binding point = attribute index).
+void attach_float_attribute(GLuint vertex_array, GLuint attribute, GLuint buffer, int components);
 
 // Compiles and links a program; throws RuntimeError naming `name` with the driver's
 // log (on one line) when compiling or linking fails.

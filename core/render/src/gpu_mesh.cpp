@@ -21,10 +21,10 @@ GpuMesh::GpuMesh(const Mesh& mesh, const char* what) {
   vertex_array_ = create_vertex_array();
   const GLuint vao = vertex_array_.get();
   positions_ = create_buffer(mesh.positions.data(), mesh.positions.size() * sizeof(glm::vec3));
-  attach_vec3_attribute(vao, 0, positions_.get());
+  attach_float_attribute(vao, 0, positions_.get(), 3);
   if (!mesh.normals.empty()) {
     normals_ = create_buffer(mesh.normals.data(), mesh.normals.size() * sizeof(glm::vec3));
-    attach_vec3_attribute(vao, 1, normals_.get());
+    attach_float_attribute(vao, 1, normals_.get(), 3);
   }
   indices_ = create_buffer(mesh.indices.data(), mesh.indices.size() * sizeof(std::uint32_t));
   glVertexArrayElementBuffer(vao, indices_.get());
@@ -32,17 +32,28 @@ GpuMesh::GpuMesh(const Mesh& mesh, const char* what) {
   vertex_count_ = mesh.positions.size();
 }
 
-void GpuMesh::set_light_attenuation(std::span<const glm::vec3> attenuation) {
-  if (attenuation.size() != vertex_count_)
-    throw InputError(std::to_string(attenuation.size()) + " light attenuation values for a mesh of " +
-                     std::to_string(vertex_count_) + " vertices; pass one per vertex");
+// One float attribute per vertex that changes: its buffer is made on the first call.
+void GpuMesh::update_attribute(GlName& buffer, GLuint attribute, int components, const void* data, std::size_t count,
+                               const char* what) {
+  if (count != vertex_count_)
+    throw InputError(std::to_string(count) + " " + what + " values for a mesh of " + std::to_string(vertex_count_) +
+                     " vertices; pass one per vertex");
   if (empty()) return;
-  if (!attenuation_) {
-    attenuation_ = create_buffer(attenuation.data(), attenuation.size_bytes(), GL_DYNAMIC_STORAGE_BIT);
-    attach_vec3_attribute(vertex_array_.get(), 2, attenuation_.get());
+  const std::size_t bytes = count * std::size_t(components) * sizeof(float);
+  if (!buffer) {
+    buffer = create_buffer(data, bytes, GL_DYNAMIC_STORAGE_BIT);
+    attach_float_attribute(vertex_array_.get(), attribute, buffer.get(), components);
   } else {
-    glNamedBufferSubData(attenuation_.get(), 0, GLsizeiptr(attenuation.size_bytes()), attenuation.data());
+    glNamedBufferSubData(buffer.get(), 0, GLsizeiptr(bytes), data);
   }
+}
+
+void GpuMesh::set_light_attenuation(std::span<const glm::vec3> attenuation) {
+  update_attribute(attenuation_, 2, 3, attenuation.data(), attenuation.size(), "light attenuation");
+}
+
+void GpuMesh::set_self_occlusion(std::span<const glm::vec4> occlusion) {
+  update_attribute(occlusion_, 3, 4, occlusion.data(), occlusion.size(), "self-occlusion");
 }
 
 void GpuMesh::draw() const {

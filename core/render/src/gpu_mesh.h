@@ -1,6 +1,7 @@
 #pragma once
 // A Mesh in GPU buffers: positions at attribute 0, normals (if any) at attribute 1, and
-// optionally one more per-vertex vec3 that changes (set_light_attenuation) at attribute 2.
+// optionally per-vertex values that change: a vec3 at attribute 2 (set_light_attenuation)
+// and a vec4 at attribute 3 (set_self_occlusion). Unset, attribute 3 reads (0, 0, 0, 1).
 #include <glm/glm.hpp>
 #include <span>
 
@@ -20,10 +21,15 @@ class GpuMesh {
   // Per-vertex factor on the light (attribute 2); the first call creates its buffer.
   // Throws InputError unless there is one value per vertex.
   void set_light_attenuation(std::span<const glm::vec3> attenuation);
+  // Per-vertex bent normal (xyz, model space) and open share (w) of the object's own
+  // occlusion (lighting/self_occlusion.h). Same rules as set_light_attenuation.
+  void set_self_occlusion(std::span<const glm::vec4> occlusion);
   void draw() const;  // binds its vertex array and draws the triangles
 
  private:
-  GlName vertex_array_, positions_, normals_, indices_, attenuation_;
+  void update_attribute(GlName& buffer, GLuint attribute, int components, const void* data, std::size_t count,
+                        const char* what);
+  GlName vertex_array_, positions_, normals_, indices_, attenuation_, occlusion_;
   GLsizei index_count_ = 0;
   std::size_t vertex_count_ = 0;
 };

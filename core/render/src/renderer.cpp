@@ -51,6 +51,37 @@ struct RenderTarget {
   }
 };
 
+// A multisampled offscreen framebuffer: colour and 32-bit float depth, `samples` each.
+struct MultisampleTarget {
+  int width = 0, height = 0, samples = 0;
+  GlName framebuffer, color, depth;
+
+  MultisampleTarget() = default;
+  MultisampleTarget(int w, int h, int n, GLenum color_format) : width(w), height(h), samples(n) {
+    framebuffer = create_framebuffer();
+    const auto texture = [&](GLenum format) {
+      GLuint id = 0;
+      glCreateTextures(GL_TEXTURE_2D_MULTISAMPLE, 1, &id);
+      glTextureStorage2DMultisample(id, n, format, w, h, GL_TRUE);
+      return GlName(id, [](GLuint t) { glDeleteTextures(1, &t); });
+    };
+    color = texture(color_format);
+    depth = texture(GL_DEPTH_COMPONENT32F);
+    glNamedFramebufferTexture(framebuffer.get(), GL_COLOR_ATTACHMENT0, color.get(), 0);
+    glNamedFramebufferTexture(framebuffer.get(), GL_DEPTH_ATTACHMENT, depth.get(), 0);
+    glNamedFramebufferDrawBuffer(framebuffer.get(), GL_COLOR_ATTACHMENT0);
+    check_framebuffer(framebuffer.get(), "the multisampled scene");
+  }
+
+  void begin() const {
+    glBindFramebuffer(GL_FRAMEBUFFER, framebuffer.get());
+    glViewport(0, 0, width, height);
+    const float zero[4] = {0, 0, 0, 0}, far = 1.0f;
+    glClearNamedFramebufferfv(framebuffer.get(), GL_COLOR, 0, zero);
+    glClearNamedFramebufferfv(framebuffer.get(), GL_DEPTH, 0, &far);
+  }
+};
+
 GLint uniform(GLuint program, const char* name) { return glGetUniformLocation(program, name); }
 
 // Wall-clock stage timer; waits for the GPU at each mark so the stages are separable.
@@ -95,7 +126,7 @@ struct Renderer::Impl {
 
   CameraIntrinsics camera;
   GlName empty_vertex_array;  // core profile needs one bound even for attribute-less draws
-  GlName background, depth_only, shaded_object, world_position, room_radiance, encode;
+  GlName background, depth_only, shaded_object, world_position, room_radiance, encode, blur;
   GpuMesh room;
   std::unique_ptr<ShadowPass> receivers;  // shadow receivers, drawn over the video
   std::vector<Object> objects;
@@ -107,16 +138,22 @@ struct Renderer::Impl {
   GlName response_decode, response_encode;  // empty: sRGB
   glm::vec3 response_max{1.0f};
   glm::vec2 vignetting{0.0f};
-  CameraIntrinsics video_camera;  // the distorted camera the vignetting is defined on
+  CameraIntrinsics video_camera;                               // the distorted camera the vignetting is defined on
+  glm::vec3 noise_read_variance{0.0f}, noise_shot_gain{0.0f};  // RGB
+  float blur_sigma = 0.0f;
+  CompositeFeatures features;
+  std::uint32_t frame_number = 0;  // seeds the noise: a new draw every frame
 
   std::unique_ptr<IrradianceTextures> volume;  // shades objects when set
   GlName environment;
   glm::vec3 capture_position{0.0f};
   glm::mat3 map_from_world{1.0f};
 
-  RenderTarget scene;        // linear colour (RGBA32F) and depth, output size
-  RenderTarget encoded;      // sRGB 8-bit, output size, rows flipped for read-back
-  RenderTarget room_target;  // for render_room_radiance, resized on demand
+  RenderTarget scene;                  // linear colour (RGBA32F) and depth, output size
+  MultisampleTarget multisampled;      // the same, antialiased; resolved into `scene`
+  RenderTarget blurred_rows, blurred;  // the blur's two passes (RGBA32F)
+  RenderTarget encoded;                // sRGB 8-bit, output size, rows flipped for read-back
+  RenderTarget room_target;            // for render_room_radiance, resized on demand
 
   Object& object(int id, const char* where) {
     if (id < 0 || id >= int(objects.size()))
@@ -150,6 +187,7 @@ struct Renderer::Impl {
     glUseProgram(program);
     if (shaded) glProgramUniform1f(program, uniform(program, "exposure"), exposure);
     if (shaded) glProgramUniform1i(program, uniform(program, "use_volume"), volume ? 1 : 0);
+    if (shaded) glProgramUniform1i(program, uniform(program, "use_self_occlusion"), features.self_occlusion ? 1 : 0);
     if (shaded && volume) volume->bind(program);
     for (const Object& o : objects) {
       set_transform(program, o.model, o.normal_matrix, vp);
@@ -178,6 +216,29 @@ struct Renderer::Impl {
     glTextureParameteri(video.get(), GL_TEXTURE_WRAP_S, wrap);
     glTextureParameteri(video.get(), GL_TEXTURE_WRAP_T, wrap);
     upload_bgr8(video.get(), frame);
+  }
+
+  // The camera's blur on what was rendered: a separable Gaussian of `linear` (rows, then
+  // columns), kept only where it reaches a rendered pixel (alpha > 0); the video
+  // elsewhere has the camera's blur already. Returns the blurred image's texture.
+  GLuint blur_rendered(GLuint linear) {
+    if (blurred.width != camera.width || blurred.height != camera.height) {
+      blurred_rows = RenderTarget(camera.width, camera.height, GL_RGBA32F, false, "the blur's rows");
+      blurred = RenderTarget(camera.width, camera.height, GL_RGBA32F, false, "the blur");
+    }
+    const GLuint p = blur.get();
+    glUseProgram(p);
+    glProgramUniform1f(p, uniform(p, "sigma"), blur_sigma);
+    glBindTextureUnit(shaders::kLinearImageUnit, linear);
+    glBindTextureUnit(shaders::kBlurSourceUnit, linear);
+    blurred_rows.begin();
+    glProgramUniform2i(p, uniform(p, "step"), 1, 0);
+    draw_fullscreen();
+    blurred.begin();
+    glBindTextureUnit(shaders::kBlurSourceUnit, blurred_rows.color.get());
+    glProgramUniform2i(p, uniform(p, "step"), 0, 1);
+    draw_fullscreen();
+    return blurred.color.get();
   }
 
   // Visible object positions after proxy occlusion, into `scene`; RGBA32F, row 0 at the bottom.
@@ -210,8 +271,13 @@ Renderer::Renderer(const CameraIntrinsics& camera) : impl_(std::make_unique<Impl
   r.world_position = create_program("world position", kMeshVertex, kWorldPositionFragment);
   r.room_radiance = create_program("room radiance", kMeshVertex, kRoomRadianceFragment);
   r.encode = create_program("sRGB encode", kFullscreenVertex, kEncodeFragment);
+  r.blur = create_program("camera blur", kFullscreenVertex, kBlurFragment);
   r.scene = RenderTarget(camera.width, camera.height, GL_RGBA32F, true, "the linear scene");
   r.encoded = RenderTarget(camera.width, camera.height, GL_RGBA8, false, "the encoded output");
+  GLint max_samples = 0;
+  glGetIntegerv(GL_MAX_SAMPLES, &max_samples);
+  if (max_samples >= 2)
+    r.multisampled = MultisampleTarget(camera.width, camera.height, std::min(4, int(max_samples)), GL_RGBA32F);
   check_gl_errors("Renderer::Renderer");
 }
 
@@ -275,6 +341,17 @@ void Renderer::set_object_light_attenuation(int id, std::span<const glm::vec3> a
   check_gl_errors("Renderer::set_object_light_attenuation");
 }
 
+void Renderer::set_object_self_occlusion(int id, std::span<const VertexOcclusion> occlusion) {
+  std::vector<glm::vec4> packed(occlusion.size());
+  for (std::size_t i = 0; i < occlusion.size(); ++i) packed[i] = glm::vec4(occlusion[i].bent_normal, occlusion[i].open);
+  impl_->object(id, "set_object_self_occlusion").mesh.set_self_occlusion(packed);
+  check_gl_errors("Renderer::set_object_self_occlusion");
+}
+
+void Renderer::set_features(const CompositeFeatures& features) { impl_->features = features; }
+
+const CompositeFeatures& Renderer::features() const { return impl_->features; }
+
 void Renderer::set_object_material(int id, const glm::vec3& albedo, const SH9& irradiance_sh) {
   Impl::Object& o = impl_->object(id, "set_object_material");
   o.albedo = albedo;
@@ -307,8 +384,21 @@ void Renderer::set_video_radiometry(const VideoRadiometry& radiometry) {
   Impl& r = *impl_;
   if (!std::isfinite(radiometry.vignetting_a) || !std::isfinite(radiometry.vignetting_b))
     throw InputError("Renderer::set_video_radiometry: vignetting coefficients must be finite");
+  for (int c = 0; c < 3; ++c) {
+    const float read = radiometry.noise_read_variance[std::size_t(c)],
+                shot = radiometry.noise_shot_gain[std::size_t(c)];
+    if (!std::isfinite(read) || !std::isfinite(shot) || read < 0 || shot < 0)
+      throw InputError("Renderer::set_video_radiometry: noise variances must be finite and non-negative");
+  }
+  if (!std::isfinite(radiometry.blur_sigma_px) || radiometry.blur_sigma_px < 0 || radiometry.blur_sigma_px > 4)
+    throw InputError("Renderer::set_video_radiometry: blur sigma must be between 0 and 4 pixels");
   r.vignetting = glm::vec2(float(radiometry.vignetting_a), float(radiometry.vignetting_b));
   r.video_camera = radiometry.video_camera;
+  for (int c = 0; c < 3; ++c) {  // BGR -> RGB
+    r.noise_read_variance[c] = radiometry.noise_read_variance[std::size_t(2 - c)];
+    r.noise_shot_gain[c] = radiometry.noise_shot_gain[std::size_t(2 - c)];
+  }
+  r.blur_sigma = float(radiometry.blur_sigma_px);
   if (radiometry.linear_of_code.empty()) {
     r.response_decode = GlName();
     r.response_encode = GlName();
@@ -363,8 +453,13 @@ cv::Mat Renderer::render_overlay(const cv::Mat& video_bgr8, const std::optional<
   r.upload_video(video_bgr8);
   clock.mark(&t.upload_ms);
 
-  // Background: the undistorted video, decoded to linear light.
-  r.scene.begin();
+  // Background: the undistorted video, decoded to linear light. With antialiasing every
+  // pass draws into the multisampled target, resolved into `scene` before the encode.
+  const bool antialias = r.features.antialiasing && r.multisampled.samples > 1 && T_world_camera;
+  if (antialias)
+    r.multisampled.begin();
+  else
+    r.scene.begin();
   glDisable(GL_DEPTH_TEST);
   glDisable(GL_BLEND);
   const GLuint bg = r.background.get();
@@ -399,7 +494,15 @@ cv::Mat Renderer::render_overlay(const cv::Mat& video_bgr8, const std::optional<
     glDepthMask(GL_TRUE);
     glDepthFunc(GL_LESS);
     glDisable(GL_DEPTH_TEST);
+    if (antialias)
+      glBlitNamedFramebuffer(r.multisampled.framebuffer.get(), r.scene.framebuffer.get(), 0, 0, r.camera.width,
+                             r.camera.height, 0, 0, r.camera.width, r.camera.height, GL_COLOR_BUFFER_BIT, GL_NEAREST);
     clock.mark(&t.objects_ms);
+  }
+  GLuint linear_image = r.scene.color.get();
+  if (T_world_camera && r.features.blur && r.blur_sigma > 0.0f) {
+    linear_image = r.blur_rendered(linear_image);
+    clock.mark(&t.blur_ms);
   }
 
   // Encode to sRGB 8-bit (rows flipped) and read back top row first.
@@ -416,8 +519,14 @@ cv::Mat Renderer::render_overlay(const cv::Mat& video_bgr8, const std::optional<
   glProgramUniform1f(enc, uniform(enc, "half_diagonal"), 0.5f * std::hypot(float(vc.width), float(vc.height)));
   glBindTextureUnit(shaders::kUndistortionMapUnit, r.undistortion_map.get());
   glProgramUniform2fv(enc, uniform(enc, "vignetting"), 1, glm::value_ptr(r.vignetting));
-  glBindTextureUnit(shaders::kLinearImageUnit, r.scene.color.get());
+  glBindTextureUnit(shaders::kLinearImageUnit, linear_image);
   glBindTextureUnit(shaders::kResponseEncodeUnit, r.response_encode.get());
+  const bool noise =
+      r.features.noise && (r.noise_read_variance != glm::vec3(0.0f) || r.noise_shot_gain != glm::vec3(0.0f));
+  glProgramUniform1i(enc, uniform(enc, "use_noise"), noise ? 1 : 0);
+  glProgramUniform3fv(enc, uniform(enc, "noise_read_variance"), 1, glm::value_ptr(r.noise_read_variance));
+  glProgramUniform3fv(enc, uniform(enc, "noise_shot_gain"), 1, glm::value_ptr(r.noise_shot_gain));
+  glProgramUniform1ui(enc, uniform(enc, "noise_seed"), r.frame_number++);
   r.draw_fullscreen();
   cv::Mat out(r.camera.height, r.camera.width, CV_8UC3);
   glPixelStorei(GL_PACK_ALIGNMENT, 1);

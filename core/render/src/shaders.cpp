@@ -16,12 +16,14 @@ const char* const kMeshVertex = R"glsl(
 layout(location = 0) in vec3 position;
 layout(location = 1) in vec3 normal;
 layout(location = 2) in vec3 light_attenuation;  // objects: what other objects take of the light
+layout(location = 3) in vec4 occlusion;          // objects: bent normal (model space), open share
 uniform mat4 model;
 uniform mat3 normal_matrix;
 uniform mat4 view_projection;
 out vec3 world_position;
 out vec3 world_normal;
 out vec3 attenuation;
+out vec4 self_occlusion;
 // The objects' depth pre-pass and their shaded pass must agree to the bit (GL_LEQUAL).
 invariant gl_Position;
 void main() {
@@ -29,6 +31,7 @@ void main() {
   world_position = w.xyz;
   world_normal = normal_matrix * normal;
   attenuation = light_attenuation;
+  self_occlusion = vec4(normal_matrix * occlusion.xyz, occlusion.w);
   gl_Position = view_projection * w;
 }
 )glsl";
@@ -81,10 +84,12 @@ const char* const kShadedObjectFragment = R"glsl(
 in vec3 world_position;
 in vec3 world_normal;
 in vec3 attenuation;
+in vec4 self_occlusion;  // bent normal (world; zero when not baked), open share
 uniform vec3 albedo;
 uniform float exposure;
 uniform vec3 sh[9];  // L00, L1-1, L10, L11, L2-2, L2-1, L20, L21, L22 (world frame)
 uniform bool use_volume;  // irradiance volume (gl/irradiance_textures.cpp) instead of sh
+uniform bool use_self_occlusion;
 vec3 volume_irradiance(vec3 p, vec3 n);
 vec3 sh9_irradiance(vec3 L0, vec3 L1, vec3 L2, vec3 L3, vec3 L4, vec3 L5, vec3 L6, vec3 L7, vec3 L8, vec3 n);
 out vec4 color;
@@ -93,9 +98,16 @@ vec3 sh_irradiance(vec3 n) { return sh9_irradiance(sh[0], sh[1], sh[2], sh[3], s
 
 void main() {
   vec3 n = normalize(world_normal);
+  // The object's own occlusion: the light of the open directions, E(bent normal), times
+  // the open share (lighting/self_occlusion.h).
+  float open = 1.0;
+  if (use_self_occlusion && dot(self_occlusion.xyz, self_occlusion.xyz) > 1e-12) {
+    n = normalize(self_occlusion.xyz);
+    open = clamp(self_occlusion.w, 0.0, 1.0);
+  }
   // Nine coefficients can ring below zero opposite a bright source; light is never negative.
   vec3 irradiance = use_volume ? volume_irradiance(world_position, n) : max(sh_irradiance(n), vec3(0.0));
-  irradiance *= clamp(attenuation, 0.0, 1.0);
+  irradiance *= clamp(attenuation, 0.0, 1.0) * open;
   color = vec4(albedo * irradiance * (exposure / 3.14159265358979), 1.0);
 }
 )glsl";
@@ -138,7 +150,26 @@ uniform vec3 lut_max;            // linear value of code 255, per channel
 uniform vec2 principal_point;    // OpenCV pixels of the video's (distorted) camera
 uniform float half_diagonal;     // of the video's image, pixels
 uniform vec2 vignetting;         // (a, b): gain 1 + a r^2 + b r^4
+uniform bool use_noise;
+uniform vec3 noise_read_variance, noise_shot_gain;  // the sensor's: variance = read + gain * linear
+uniform uint noise_seed;         // a new one every frame
 out vec4 color;
+
+// A 32-bit integer hash (Wellons' "lowbias32"): the noise's random numbers, per pixel and frame.
+uint noise_hash(uint x) {
+  x ^= x >> 16; x *= 0x7feb352du; x ^= x >> 15; x *= 0x846ca68bu; x ^= x >> 16;
+  return x;
+}
+float noise_uniform(uint h) { return (float(h >> 8) + 0.5) / 16777216.0; }
+// Three independent standard normal numbers (Box-Muller).
+vec3 noise_gaussian(ivec2 pixel) {
+  uint h = noise_hash(uint(pixel.x) + noise_hash(uint(pixel.y) + noise_hash(noise_seed)));
+  float u1 = noise_uniform(h), u2 = noise_uniform(noise_hash(h ^ 0x9e3779b9u));
+  float u3 = noise_uniform(noise_hash(h ^ 0x85ebca6bu)), u4 = noise_uniform(noise_hash(h ^ 0xc2b2ae35u));
+  float r1 = sqrt(-2.0 * log(u1)), r2 = sqrt(-2.0 * log(u3));
+  const float tau = 6.28318530717959;
+  return vec3(r1 * cos(tau * u2), r1 * sin(tau * u2), r2 * cos(tau * u4));
+}
 
 vec3 linear_to_srgb(vec3 v) {
   v = clamp(v, 0.0, 1.0);
@@ -158,6 +189,10 @@ void main() {
   if (use_undistortion_map) pixel = texelFetch(undistortion_map, ivec2(pixel), 0).xy;
   float r2 = dot(pixel - principal_point, pixel - principal_point) / (half_diagonal * half_diagonal);
   vec3 linear = v.rgb * mix(1.0, 1.0 + vignetting.x * r2 + vignetting.y * r2 * r2, v.a);
+  // The sensor's noise on what was rendered, in proportion to its share of the pixel
+  // (the video's own pixels have theirs).
+  if (use_noise && v.a > 0.0)
+    linear += v.a * noise_gaussian(p) * sqrt(noise_read_variance + noise_shot_gain * max(linear, vec3(0.0)));
   if (use_response_lut) {
     vec3 s = sqrt(clamp(linear / lut_max, 0.0, 1.0));
     float n = float(textureSize(response_encode, 0).x);
@@ -167,6 +202,30 @@ void main() {
   } else {
     color = vec4(linear_to_srgb(linear), 1.0);
   }
+}
+)glsl";
+
+const char* const kBlurFragment = R"glsl(
+#version 450 core
+layout(binding = 3) uniform sampler2D linear_image;  // the unblurred image (alpha 1: rendered)
+layout(binding = 6) uniform sampler2D source;        // this pass's input
+uniform float sigma;  // pixels
+uniform ivec2 step;   // (1, 0): rows; (0, 1): columns, the last pass
+out vec4 color;
+void main() {
+  ivec2 p = ivec2(gl_FragCoord.xy), size = textureSize(source, 0);
+  int radius = min(int(ceil(3.0 * sigma)), 12);
+  vec4 sum = vec4(0.0);
+  float total = 0.0;
+  for (int i = -radius; i <= radius; ++i) {
+    float w = exp(-0.5 * float(i * i) / (sigma * sigma));
+    sum += w * texelFetch(source, clamp(p + i * step, ivec2(0), size - 1), 0);
+    total += w;
+  }
+  vec4 b = sum / total;
+  // After the columns: the blur where it reaches a rendered pixel, the video as it was
+  // elsewhere (the camera blurred it already).
+  color = step.y == 1 && b.a <= 0.0 ? texelFetch(linear_image, p, 0) : b;
 }
 )glsl";
 

@@ -44,10 +44,10 @@ void ShadowPass::set_receivers(const Mesh& mesh) {
   vertex_array_ = create_vertex_array();
   const GLuint vao = vertex_array_.get();
   positions_ = create_buffer(mesh.positions.data(), mesh.positions.size() * sizeof(glm::vec3));
-  attach_vec3_attribute(vao, 0, positions_.get());
+  attach_float_attribute(vao, 0, positions_.get(), 3);
   const std::vector<glm::vec3> ones(mesh.positions.size(), glm::vec3(1.0f));
   attenuation_ = create_buffer(ones.data(), ones.size() * sizeof(glm::vec3), GL_DYNAMIC_STORAGE_BIT);
-  attach_vec3_attribute(vao, 2, attenuation_.get());
+  attach_float_attribute(vao, 2, attenuation_.get(), 3);
   indices_ = create_buffer(mesh.indices.data(), mesh.indices.size() * sizeof(std::uint32_t));
   glVertexArrayElementBuffer(vao, indices_.get());
   index_count_ = GLsizei(mesh.indices.size());

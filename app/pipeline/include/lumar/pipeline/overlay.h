@@ -26,10 +26,15 @@ struct OverlaySettings {
   bool window = false;  // a GLFW window to draw into; else a headless EGL context
   std::string window_title = "lumar overlay";
   bool volume_cache = true;  // the irradiance volume from / into the disk cache
+  // What makes the objects look like the camera's pixels; the camera's noise and blur
+  // are estimated from the first frames of the video (calib/sensor_noise.h,
+  // calib/camera_blur.h) unless blur_sigma_px >= 0 gives the blur.
+  gl::CompositeFeatures features;
+  double blur_sigma_px = -1.0;
 };
 
 struct StageTimes {  // milliseconds, summed over frames
-  double decode = 0, pose = 0, lighting = 0, upload = 0, background = 0, depth = 0, objects = 0, readback = 0,
+  double decode = 0, pose = 0, lighting = 0, upload = 0, background = 0, depth = 0, objects = 0, blur = 0, readback = 0,
          output = 0;
   int frames = 0;
 };
@@ -64,6 +69,8 @@ class Overlay {
   const StageTimes& times() const { return times_; }
   int frames_without_pose() const { return frames_without_pose_; }
   const LiveLighting* live_lighting() const { return live_lighting_ ? &*live_lighting_ : nullptr; }
+  // The video's radiometry as the renderer has it now (noise and blur once measured).
+  const gl::VideoRadiometry& video_radiometry() const { return radiometry_; }
 
  private:
   std::unique_ptr<gl::Context> context_;
@@ -71,6 +78,14 @@ class Overlay {
   std::unique_ptr<Compositor> compositor_;
   double exposure_ = 1.0;
   std::optional<LiveLighting> live_lighting_;
+  // The camera's noise and blur, measured from the video until they are known.
+  void measure_camera(const cv::Mat& video);
+  calib::UndistortionMaps maps_;
+  calib::CameraResponse response_;
+  gl::VideoRadiometry radiometry_;
+  gl::CompositeFeatures features_;
+  bool noise_known_ = false, blur_known_ = false, warned_ = false;
+  std::int64_t frames_seen_ = 0;
   StageTimes times_;
   int frames_without_pose_ = 0;
 };

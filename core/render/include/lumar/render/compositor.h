@@ -39,6 +39,9 @@ class Compositor {
   // Soft shadows of the objects on the receivers and, with two objects or more, on each
   // other (docs/shadows.md); on by default.
   void set_shadows_enabled(bool on);
+  // Antialiasing, self-occlusion, noise and blur (gl::CompositeFeatures); all on by
+  // default. The objects' self-occlusion is baked the first time it is on.
+  void set_features(const gl::CompositeFeatures& features);
   // The shadow lines, or nullptr when the scene has no receivers.
   const LineShadows* shadows() const { return shadows_.get(); }
   // The objects' shadows on each other, or nullptr with fewer than two objects.
@@ -62,6 +65,8 @@ class Compositor {
   std::unique_ptr<gl::Renderer> renderer_;
   std::shared_ptr<IrradianceVolume> volume_;  // shared_ptr: incomplete here
   void build_shadows();
+  void bake_self_occlusion_once();
+  bool self_occlusion_baked_ = false;
   std::vector<glm::dvec3> object_points_;
   std::shared_ptr<LineShadows> shadows_;  // shared_ptr: LineShadows is incomplete here
   std::shared_ptr<ObjectShadows> object_shadows_;

@@ -16,6 +16,7 @@
 
 #include "lumar/base/camera.h"
 #include "lumar/base/pose.h"
+#include "lumar/lighting/self_occlusion.h"
 #include "lumar/lighting/sh.h"
 #include "lumar/scene/envmap.h"
 #include "lumar/scene/mesh.h"
@@ -29,7 +30,7 @@ namespace lumar::gl {
 // Wall time of each stage of render_overlay. Asking for timings makes the stages wait
 // for each other (glFinish between them), so ask only when profiling.
 struct OverlayTimings {
-  double upload_ms = 0, background_ms = 0, depth_ms = 0, objects_ms = 0, readback_ms = 0;
+  double upload_ms = 0, background_ms = 0, depth_ms = 0, objects_ms = 0, blur_ms = 0, readback_ms = 0;
 };
 
 // How the camera turned light into video, so that rendered pixels look like the
@@ -43,6 +44,20 @@ struct VideoRadiometry {
   // Without an undistortion map or a valid video_camera: the output camera's pixels.
   double vignetting_a = 0.0, vignetting_b = 0.0;
   CameraIntrinsics video_camera;
+  // The sensor's noise per channel (B, G, R) in the response's linear units: variance
+  // read_variance + shot_gain * linear (calib/sensor_noise.h estimates it from video).
+  std::array<float, 3> noise_read_variance{}, noise_shot_gain{};
+  // The camera's blur (lens, sensor, resampling) as a Gaussian, output pixels.
+  double blur_sigma_px = 0.0;
+};
+
+// What makes rendered pixels look like the camera's own around them (docs/ground_truth.md,
+// "What closes the gap"); each can be switched off to measure what it brings.
+struct CompositeFeatures {
+  bool antialiasing = true;    // four samples per pixel (MSAA) on the objects' edges
+  bool self_occlusion = true;  // the objects' baked occlusion of themselves
+  bool noise = true;           // VideoRadiometry's noise on rendered pixels
+  bool blur = true;            // VideoRadiometry's blur on rendered pixels and their edges
 };
 
 class Renderer {
@@ -67,6 +82,9 @@ class Renderer {
   // other objects block some of it (object_shadows.h): multiplies its irradiance.
   // 1 until set; throws InputError unless there is one value per vertex.
   void set_object_light_attenuation(int id, std::span<const glm::vec3> attenuation);
+  // Per vertex (mesh order), the object's occlusion of itself (bake_self_occlusion);
+  // unset, the object is open everywhere. Throws InputError unless one value per vertex.
+  void set_object_self_occlusion(int id, std::span<const VertexOcclusion> occlusion);
   // Shade every object per pixel from this irradiance volume (uploaded as textures;
   // core/irradiance_volume.h) instead of its SH9; nullptr goes back to SH9.
   void set_irradiance_volume(const IrradianceVolume* volume);
@@ -86,6 +104,9 @@ class Renderer {
   // pass through unchanged; rendered pixels get the vignetting and the response.
   // Throws InputError for a table that is not 3 x 256 finite non-decreasing values.
   void set_video_radiometry(const VideoRadiometry& radiometry);
+  // Default: all on. Antialiasing needs the driver's multisampling (4 samples, else what it has).
+  void set_features(const CompositeFeatures& features);
+  const CompositeFeatures& features() const;
 
   // One composited frame (BGR8, output size). `video_bgr8` is the distorted video frame
   // (CV_8UC3, the undistortion map's source size); `exposure` is the video's linear

@@ -1,0 +1,172 @@
+// What makes rendered pixels look like the camera's (gl::CompositeFeatures), each against
+// an analytic expectation and switched off: the sensor's noise statistics, the coverage
+// that antialiasing gives a disc's outline, the Gaussian profile of a blurred edge, and the
+// self-occlusion's open share and bent normal.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+
+#include "lumar/base/color.h"
+#include "lumar/base/constants.h"
+#include "lumar/base/error.h"
+#include "lumar/render/renderer.h"
+#include "render_test_util.h"
+
+namespace lumar::test {
+namespace {
+
+// Uniform incoming radiance r: E = pi r, so the object's linear value is albedo r exposure.
+SH9 uniform_light(double r) {
+  SH9 sh;
+  sh.coefficients[0] = glm::dvec3(r * 0.282095 * 4.0 * kPi);
+  return sh;
+}
+
+cv::Mat linear_of(const cv::Mat& bgr8) {
+  cv::Mat out(bgr8.size(), CV_32FC3);
+  for (int r = 0; r < bgr8.rows; ++r)
+    for (int c = 0; c < bgr8.cols; ++c)
+      for (int k = 0; k < 3; ++k)
+        out.at<cv::Vec3f>(r, c)[k] = srgb_to_linear(float(bgr8.at<cv::Vec3b>(r, c)[k]) / 255.0f);
+  return out;
+}
+
+constexpr gl::CompositeFeatures kNone{false, false, false, false};
+
+// A camera looking down -z at a quad of `half` half-width at z = -2, lit to linear `value`.
+struct FlatObject {
+  explicit FlatObject(float value, float half = 0.5f, glm::vec3 centre = {0, 0, -2}) {
+    renderer = std::make_unique<gl::Renderer>(camera);
+    id = renderer->add_object(make_quad(centre, {half, 0, 0}, {0, half, 0}, {0, 0, 1}));
+    renderer->set_object_material(id, glm::vec3(1.0f), uniform_light(value));
+  }
+  CameraIntrinsics camera = make_camera(160, 120, 150, 150, 79.5, 59.5);
+  Pose pose = look_at({0, 0, 0}, {0, 0, -1});
+  std::unique_ptr<gl::Renderer> renderer;
+  int id = 0;
+};
+
+TEST(CompositeFeatures, NoiseHasTheSensorsVarianceOnRenderedPixelsOnly) {
+  headless_context();
+  FlatObject flat(0.3f);
+  gl::VideoRadiometry radiometry;
+  radiometry.noise_read_variance = {4e-4f, 1e-4f, 2.5e-5f};
+  radiometry.noise_shot_gain = {0.0f, 2e-3f, 4e-3f};
+  flat.renderer->set_video_radiometry(radiometry);
+  flat.renderer->set_features({.antialiasing = false, .self_occlusion = false, .noise = true, .blur = false});
+  const cv::Mat video(120, 160, CV_8UC3, cv::Scalar(40, 80, 120));
+  const cv::Mat first = flat.renderer->render_overlay(video, flat.pose, 1.0);
+  const cv::Mat second = flat.renderer->render_overlay(video, flat.pose, 1.0);
+  const cv::Mat mask = flat.renderer->render_object_mask(flat.pose);
+  ASSERT_GT(cv::countNonZero(mask), 4000);
+  cv::Mat diff;
+  cv::absdiff(first, video, diff);
+  cv::Mat background_changed;
+  cv::reduce(diff.reshape(1, int(diff.total())), background_changed, 1, cv::REDUCE_MAX);
+  EXPECT_EQ(cv::countNonZero(background_changed.reshape(1, 120) & ~mask), 0) << "the video is the camera's already";
+  cv::Scalar mean, sd;
+  cv::meanStdDev(linear_of(first), mean, sd, mask);
+  for (int k = 0; k < 3; ++k) {
+    const double expected = std::sqrt(radiometry.noise_read_variance[k] + radiometry.noise_shot_gain[k] * 0.3);
+    // 8-bit rounding adds (dlinear/dcode)^2 / 12: about 0.0005 near 0.3 (sRGB), a few % here.
+    EXPECT_NEAR(sd[k], expected, 0.08 * expected) << "channel " << k;
+    EXPECT_NEAR(mean[k], 0.3, 0.01);
+  }
+  EXPECT_GT(cv::norm(first, second, cv::NORM_L1, mask), 0.0) << "a new draw every frame";
+
+  flat.renderer->set_features(kNone);
+  cv::meanStdDev(linear_of(flat.renderer->render_overlay(video, flat.pose, 1.0)), mean, sd, mask);
+  EXPECT_LT(sd[0] + sd[1] + sd[2], 1e-6);
+}
+
+TEST(CompositeFeatures, AntialiasingGivesTheOutlineItsCoverage) {
+  headless_context();
+  const CameraIntrinsics camera = make_camera(320, 240, 300, 300, 159.5, 119.5);
+  const Pose pose = look_at({0, 0, 0}, {0, 0, -1});
+  gl::Renderer renderer(camera);
+  const float radius = 0.3f;
+  const int sphere = renderer.add_object(make_sphere({0, 0, -2}, radius, 256, 128));
+  renderer.set_object_material(sphere, glm::vec3(1.0f), uniform_light(0.5));
+  const cv::Mat black(240, 320, CV_8UC3, cv::Scalar::all(0));
+  // A sphere straight ahead is a disc of radius f r / sqrt(d^2 - r^2).
+  const double disc_radius = 300.0 * radius / std::sqrt(4.0 - radius * radius);
+  const double area = std::numbers::pi * disc_radius * disc_radius;
+  const auto measure = [&](bool antialiasing, int* partial) {
+    renderer.set_features({.antialiasing = antialiasing, .self_occlusion = false, .noise = false, .blur = false});
+    const cv::Mat out = linear_of(renderer.render_overlay(black, pose, 1.0));
+    *partial = 0;
+    for (int r = 0; r < out.rows; ++r)
+      for (int c = 0; c < out.cols; ++c)
+        *partial += out.at<cv::Vec3f>(r, c)[1] > 0.02f && out.at<cv::Vec3f>(r, c)[1] < 0.48f;
+    // Covered area in pixels: the sum over the inside's value (0.5 after 8-bit rounding).
+    return cv::sum(out)[1] / out.at<cv::Vec3f>(120, 160)[1];
+  };
+  int partial_aa = 0, partial_plain = 0;
+  const double covered_aa = measure(true, &partial_aa), covered_plain = measure(false, &partial_plain);
+  std::printf("disc %.1f px: antialiased %.1f px (%d partly covered), plain %.1f px (%d)\n", area, covered_aa,
+              partial_aa, covered_plain, partial_plain);
+  EXPECT_NEAR(covered_aa, area, 0.003 * area);
+  EXPECT_GT(partial_aa, int(2.0 * disc_radius * std::numbers::pi * 0.5));  // along most of the outline
+  EXPECT_EQ(partial_plain, 0);
+}
+
+TEST(CompositeFeatures, BlurGivesAnEdgeTheCamerasGaussianProfile) {
+  headless_context();
+  // A quad whose left edge is at x = 0, the boundary between columns 79 and 80.
+  FlatObject flat(0.5f, 1.0f, {1.0f, 0.0f, -2.0f});
+  gl::VideoRadiometry radiometry;
+  radiometry.blur_sigma_px = 1.5;
+  flat.renderer->set_video_radiometry(radiometry);
+  flat.renderer->set_features({.antialiasing = true, .self_occlusion = false, .noise = false, .blur = true});
+  const cv::Mat black(120, 160, CV_8UC3, cv::Scalar::all(0));
+  const cv::Mat out = linear_of(flat.renderer->render_overlay(black, flat.pose, 1.0));
+  // The pixel's own area (a box, variance 1/12) and the Gaussian: a normal CDF across the edge.
+  const double sigma = std::sqrt(1.5 * 1.5 + 1.0 / 12.0);
+  double worst = 0;
+  for (int c = 72; c <= 88; ++c) {
+    const double expected = 0.5 * 0.5 * std::erfc(-(c - 79.5) / (sigma * std::sqrt(2.0)));
+    worst = std::max(worst, std::abs(out.at<cv::Vec3f>(60, c)[1] - expected));
+  }
+  std::printf("blurred edge: worst |profile - normal CDF| %.4f of 0.5\n", worst);
+  EXPECT_LT(worst, 0.012);
+  EXPECT_EQ(out.at<cv::Vec3f>(60, 40)[1], 0.0f) << "beyond the blur the video stays as it was";
+
+  flat.renderer->set_features(kNone);
+  const cv::Mat sharp = linear_of(flat.renderer->render_overlay(black, flat.pose, 1.0));
+  EXPECT_EQ(sharp.at<cv::Vec3f>(60, 79)[1], 0.0f);
+  EXPECT_NEAR(sharp.at<cv::Vec3f>(60, 80)[1], 0.5f, 0.005f);
+}
+
+TEST(CompositeFeatures, SelfOcclusionLightsTheOpenShareFromTheBentNormal) {
+  headless_context();
+  FlatObject flat(0.0f);
+  // Light from the upper hemisphere only: E(up) = pi, E(facing the camera, +z) = pi / 2.
+  SH9 sky;
+  sky.coefficients[0] = glm::dvec3(0.282095 * 2.0 * kPi);  // a unit upper hemisphere: L00
+  sky.coefficients[1] = glm::dvec3(0.488603 * kPi);        // and L1-1 (y)
+  flat.renderer->set_object_material(flat.id, glm::vec3(1.0f), sky);
+  const cv::Mat black(120, 160, CV_8UC3, cv::Scalar::all(0));
+  const auto centre_value = [&] {
+    return linear_of(flat.renderer->render_overlay(black, flat.pose, 1.0)).at<cv::Vec3f>(60, 80)[1];
+  };
+  flat.renderer->set_features(kNone);
+  const float plain = centre_value();
+  // Half open, bent straight up: E(up) / 2 = E(+z).
+  std::vector<VertexOcclusion> occlusion(4, VertexOcclusion{{0, 1, 0}, 0.5f});
+  flat.renderer->set_object_self_occlusion(flat.id, occlusion);
+  flat.renderer->set_features({.antialiasing = false, .self_occlusion = true, .noise = false, .blur = false});
+  const float bent_up = centre_value();
+  // Half open along its own normal: half of E(+z).
+  for (auto& o : occlusion) o.bent_normal = {0, 0, 1};
+  flat.renderer->set_object_self_occlusion(flat.id, occlusion);
+  const float half = centre_value();
+  std::printf("self-occlusion: plain %.4f, half open bent up %.4f, half open %.4f\n", plain, bent_up, half);
+  EXPECT_NEAR(plain, 0.5f, 0.01f);
+  EXPECT_NEAR(bent_up, plain, 0.01f);
+  EXPECT_NEAR(half, 0.5f * plain, 0.006f);
+  EXPECT_THROW(flat.renderer->set_object_self_occlusion(flat.id, std::vector<VertexOcclusion>(3)), InputError);
+}
+
+}  // namespace
+}  // namespace lumar::test
