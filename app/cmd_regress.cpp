@@ -18,6 +18,7 @@
 #include "lumar/calib/undistortion.h"
 #include "lumar/pipeline/composite_error.h"
 #include "lumar/pipeline/replay_overlay.h"
+#include "lumar/pipeline/truth_comparison.h"
 
 namespace lumar::app {
 
@@ -83,41 +84,18 @@ struct Outcome {
   json record;  // --json: what the line says, by key
 };
 
-// The composite against truth/ (docs/ground_truth.md), replayed with the true poses so
-// that registration is not part of the measure; nothing when the recording has no truth.
+// The composite against truth/ (docs/ground_truth.md), with the features `without` names
+// switched off; nothing when the recording has no truth.
 std::optional<pipeline::CompositeError> composite_error(const fs::path& dir, const RegressOptions& o,
                                                         const std::string& without) {
-  const fs::path truth = dir / "truth";
-  if (!fs::is_directory(truth)) return std::nullopt;
   pipeline::ReplayOverlaySettings settings;
   apply_composite_features(without, o.blur_sigma, settings.overlay);
   settings.scene = o.scene;
-  settings.poses = pipeline::PoseSource::Truth;
   settings.overlay.volume_cache = !o.no_cache;
   settings.allow_incomplete = o.allow_incomplete;
-  pipeline::ReplayOverlay overlay(dir, settings);
-  const capture::Session& session = overlay.replay().session();
-  const calib::UndistortionMaps maps = calib::make_undistortion_maps(session.camera, settings.overlay.undistortion);
-  pipeline::CompositeErrorMeter meter(
-      calib::calibrated_response(session.radiometry, dir).value_or(calib::srgb_response(1.0)));
-  const auto read = [&](const char* kind, std::int64_t index, int flags) {
-    const fs::path file = truth / fmt::format("{}-{:05d}.png", kind, index);
-    const cv::Mat image = cv::imread(file.string(), flags);
-    if (image.empty()) throw InputError(file.string() + ": missing or unreadable truth frame");
-    if (image.size() != maps.map_x.size())
-      throw InputError(file.string() + ": truth frame is " + std::to_string(image.cols) + "x" +
-                       std::to_string(image.rows) + ", not the video's size");
-    return calib::undistort_image(image, maps);
-  };
-  overlay.run(0, [&](const pipeline::OverlayFrame& f) {
-    if (!f.T_world_camera) return true;
-    const cv::Mat mask = read("mask", f.index, cv::IMREAD_GRAYSCALE) > 127;
-    // The empty room uncompressed, so that the video codec's loss is not taken for a shadow.
-    meter.add(f.composite, read("frame", f.index, cv::IMREAD_COLOR), read("other-seed", f.index, cv::IMREAD_COLOR),
-              read("empty", f.index, cv::IMREAD_COLOR), mask);
-    return true;
-  });
-  return meter.result();
+  const auto compared = pipeline::compare_with_truth(dir, settings);
+  if (!compared) return std::nullopt;
+  return compared->error;
 }
 
 Outcome regress_one(const fs::path& dir, const RegressOptions& o) {
@@ -245,15 +223,16 @@ Outcome regress_one(const fs::path& dir, const RegressOptions& o) {
                 {"render_projection_mean_px", render_error}};
   for (const char* key : {"object_err", "edge_err", "shadow_err", "noise_ratio", "noise_floor_object_err",
                           "noise_floor_edge_err", "noise_floor_shadow_err", "all_off_object_err", "all_off_edge_err",
-                          "all_off_shadow_err", "all_off_noise_ratio"})
+                          "all_off_shadow_err", "all_off_noise_ratio", "specks"})
     out.record[key] = nullptr;
   if (measured) {
     const pipeline::CompositeError& e = *measured;
     out.line += fmt::format(
         "\n  composite vs truth (true poses, {} frames, 5x5 box, linear): object {:.2f} % (noise floor {:.2f} %), "
-        "edge {:.2f} % ({:.2f} %), shadow {:.2f} % ({:.2f} %) over {} / {} / {} pixels; noise ratio {:.2f}",
+        "edge {:.2f} % ({:.2f} %), shadow {:.2f} % ({:.2f} %) over {} / {} / {} pixels; noise ratio {:.2f}; {} "
+        "dark specks",
         e.frames, e.object_err, e.noise_floor_object_err, e.edge_err, e.noise_floor_edge_err, e.shadow_err,
-        e.noise_floor_shadow_err, e.pixels[0], e.pixels[1], e.pixels[2], e.noise_ratio);
+        e.noise_floor_shadow_err, e.pixels[0], e.pixels[1], e.pixels[2], e.noise_ratio, e.specks);
     const pipeline::CompositeError& off = *all_off;
     out.line += fmt::format(
         "\n  the same with --without all: object {:.2f} %, edge {:.2f} %, shadow {:.2f} %; noise ratio {:.2f}",
@@ -266,6 +245,7 @@ Outcome regress_one(const fs::path& dir, const RegressOptions& o) {
     out.record["edge_err"] = e.edge_err;
     out.record["shadow_err"] = e.shadow_err;
     out.record["noise_ratio"] = e.noise_ratio;
+    out.record["specks"] = e.specks;
     out.record["noise_floor_object_err"] = e.noise_floor_object_err;
     out.record["noise_floor_edge_err"] = e.noise_floor_edge_err;
     out.record["noise_floor_shadow_err"] = e.noise_floor_shadow_err;

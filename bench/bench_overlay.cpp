@@ -1,7 +1,9 @@
 // Overlay at 640x480 on the sample recording, through the pipeline library that `lumar
 // overlay` runs (pipeline/replay_overlay.h: the session's radiometry, the tracker's poses):
 // time per stage, and replay throughput. Baseline: decoding one video frame, measured in
-// the same run.
+// the same run. The composite is timed with every feature that makes it look like the
+// camera's pixels (antialiasing, self-occlusion, noise, blur: docs/ground_truth.md) and
+// again with them all off, so that their cost is a ratio from the same run.
 #include <benchmark/benchmark.h>
 
 #include "bench_report.h"
@@ -13,8 +15,15 @@ namespace {
 
 const std::filesystem::path kRecording = std::filesystem::path(LUMAR_SOURCE_DIR) / "recordings/orbit";
 
+pipeline::ReplayOverlaySettings with_features(bool on) {
+  pipeline::ReplayOverlaySettings s;
+  if (!on) s.overlay.features = {false, false, false, false};
+  return s;
+}
+
 struct Fixture {
-  pipeline::ReplayOverlay overlay{kRecording};
+  explicit Fixture(bool features = true) : overlay(kRecording, with_features(features)) {}
+  pipeline::ReplayOverlay overlay;
   std::unique_ptr<capture::FrameSource> frames = overlay.replay().open_frames();
   capture::Frame frame;
 
@@ -33,14 +42,19 @@ Fixture& fixture() {
   return f;
 }
 
+Fixture& plain_fixture() {
+  static Fixture f(false);
+  return f;
+}
+
 void decode_frame(benchmark::State& state) {
   auto& f = fixture();
   for (auto _ : state) benchmark::DoNotOptimize(f.next().image.data);
 }
 
 // One frame again and again: the rendering stages alone.
-void composite_frame(benchmark::State& state) {
-  auto& f = fixture();
+void composite_frame(benchmark::State& state, bool features) {
+  auto& f = features ? fixture() : plain_fixture();
   const capture::Frame frame = f.next();
   const auto pose = f.overlay.replay().tracked_camera_pose(frame.time);
   pipeline::Overlay& overlay = f.overlay.overlay();
@@ -52,6 +66,8 @@ void composite_frame(benchmark::State& state) {
   state.counters["background_ms"] = C(after.background - before.background, C::kAvgIterations);
   state.counters["depth_ms"] = C(after.depth - before.depth, C::kAvgIterations);
   state.counters["objects_ms"] = C(after.objects - before.objects, C::kAvgIterations);
+  state.counters["antialiasing_ms"] = C(after.antialiasing - before.antialiasing, C::kAvgIterations);
+  state.counters["blur_ms"] = C(after.blur - before.blur, C::kAvgIterations);
   state.counters["readback_ms"] = C(after.readback - before.readback, C::kAvgIterations);
 }
 
@@ -74,7 +90,11 @@ int main(int argc, char** argv) {
       ->Unit(benchmark::kMillisecond)
       ->MinTime(1.0)
       ->UseRealTime();
-  benchmark::RegisterBenchmark("composite_frame", composite_frame)
+  benchmark::RegisterBenchmark("composite_frame", composite_frame, true)
+      ->Unit(benchmark::kMillisecond)
+      ->MinTime(2.0)
+      ->UseRealTime();
+  benchmark::RegisterBenchmark("composite_frame_features_off", composite_frame, false)
       ->Unit(benchmark::kMillisecond)
       ->MinTime(2.0)
       ->UseRealTime();
@@ -89,7 +109,8 @@ int main(int argc, char** argv) {
   const auto* decode = reporter.find("decode_frame");
   const auto* composite = reporter.find("composite_frame");
   const auto* replay = reporter.find("replay_frame");
-  if (!decode || !composite || !replay) return 0;  // a filtered run: no report
+  const auto* plain = reporter.find("composite_frame_features_off");
+  if (!decode || !composite || !replay || !plain) return 0;  // a filtered run: no report
   const auto& c = composite->counters;
   const int frames_per_pass = int(fixture().overlay.replay().reader().frames().size());
   const double replay_ms = replay->time_ms / std::max(1, frames_per_pass);
@@ -97,12 +118,23 @@ int main(int argc, char** argv) {
   report.name = "overlay_stages";
   report.title = "Overlay at 640x480, sample recording, Mesa llvmpipe: time per stage";
   report.baseline = "decode one video frame";
-  report.entries = {{"decode one video frame", decode->time_ms},       {"upload frame", c.at("upload_ms")},
-                    {"background (undistort)", c.at("background_ms")}, {"proxy depth", c.at("depth_ms")},
-                    {"virtual objects (volume)", c.at("objects_ms")},  {"read back", c.at("readback_ms")},
-                    {"composite, all stages", composite->time_ms},     {"replay: decode+pose+composite", replay_ms}};
+  report.entries = {{"decode one video frame", decode->time_ms},
+                    {"upload frame", c.at("upload_ms")},
+                    {"background (undistort)", c.at("background_ms")},
+                    {"proxy depth", c.at("depth_ms")},
+                    {"virtual objects (volume)", c.at("objects_ms")},
+                    {"antialiasing", c.at("antialiasing_ms")},
+                    {"camera blur", c.at("blur_ms")},
+                    {"read back", c.at("readback_ms")},
+                    {"composite, all stages", composite->time_ms},
+                    {"composite, features off", plain->time_ms},
+                    {"replay: decode+pose+composite", replay_ms}};
   report.compute_ratios();
   report.save(bench::results_dir());
   std::printf("replay throughput: %.1f frames/s\n", 1000.0 / replay_ms);
+  std::printf(
+      "antialiasing, self-occlusion, noise and blur: %.2f ms per 640x480 frame (composite %.2f ms, %.2f x the %.2f ms "
+      "with them off)\n",
+      composite->time_ms - plain->time_ms, composite->time_ms, composite->time_ms / plain->time_ms, plain->time_ms);
   return 0;
 }

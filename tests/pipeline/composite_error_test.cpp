@@ -97,6 +97,22 @@ TEST(CompositeError, AnExactCompositeHasNoErrorAndTheTruthsNoise) {
   CompositeErrorMeter noisy(calib::srgb_response(1.0));
   noisy.add(composite, truth, other, frame(100, 100), mask);
   EXPECT_NEAR(noisy.result().noise_ratio, 2.0, 0.15);
+  EXPECT_EQ(noisy.result().specks, 0) << "noise makes no specks";
+}
+
+TEST(CompositeError, DarkSpecksTheTruthDoesNotHaveAreCounted) {
+  const cv::Mat mask = disc_mask();
+  const cv::Mat truth = frame(100, 160);
+  cv::Mat composite = truth.clone();
+  // Three dark pixels inside the object, one where the truth has one too, one on the room.
+  for (const cv::Point p : {cv::Point(60, 80), cv::Point(75, 70), cv::Point(80, 95)})
+    composite.at<cv::Vec3b>(p) = cv::Vec3b(20, 20, 20);
+  cv::Mat truth_with_hole = truth.clone();
+  truth_with_hole.at<cv::Vec3b>(cv::Point(80, 95)) = cv::Vec3b(20, 20, 20);
+  composite.at<cv::Vec3b>(cv::Point(150, 20)) = cv::Vec3b(5, 5, 5);
+  CompositeErrorMeter meter(calib::srgb_response(1.0));
+  meter.add(composite, truth_with_hole, truth_with_hole, frame(100, 100), mask);
+  EXPECT_EQ(meter.result().specks, 2);
 }
 
 }  // namespace

@@ -113,6 +113,9 @@ OverlayFrame Overlay::composite(const capture::Frame& frame, const std::optional
   out.video = frame.image;
   out.T_world_camera = T_world_camera;
   if (!T_world_camera) ++frames_without_pose_;
+  // A process may hold several overlays (the benchmark's with and without features),
+  // each with its own context: draw in this one's.
+  context_->make_current();
   measure_camera(frame.image);
   if (live_lighting_ && T_world_camera) {
     const auto t0 = std::chrono::steady_clock::now();
@@ -126,6 +129,7 @@ OverlayFrame Overlay::composite(const capture::Frame& frame, const std::optional
   times_.background += gt.background_ms;
   times_.depth += gt.depth_ms;
   times_.objects += gt.objects_ms;
+  times_.antialiasing += gt.antialiasing_ms;
   times_.blur += gt.blur_ms;
   times_.readback += gt.readback_ms;
   ++times_.frames;
@@ -141,6 +145,7 @@ std::string format_stage_times(const StageTimes& t) {
                                                    {"background (undistort)", t.background},
                                                    {"proxy depth", t.depth},
                                                    {"virtual objects", t.objects},
+                                                   {"antialiasing", t.antialiasing},
                                                    {"camera blur", t.blur},
                                                    {"read back", t.readback},
                                                    {"encode output", t.output}};

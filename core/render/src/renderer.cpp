@@ -7,6 +7,7 @@
 #include <glm/gtc/matrix_transform.hpp>
 #include <glm/gtc/type_ptr.hpp>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "gl_util.h"
@@ -122,11 +123,32 @@ struct Renderer::Impl {
     glm::mat3 normal_matrix{1.0f};
     glm::vec3 albedo{0.8f};
     std::array<glm::vec3, 9> sh{};
+    glm::vec3 lo{0.0f}, hi{0.0f};  // model-space bounds
   };
+
+  // The pixels the objects may cover (their boxes projected, 2 px more), clipped to the
+  // image; the whole image when a box reaches behind the camera.
+  cv::Rect objects_footprint(const glm::mat4& vp) const {
+    const cv::Rect image(0, 0, camera.width, camera.height);
+    float x0 = 1e30f, y0 = 1e30f, x1 = -1e30f, y1 = -1e30f;
+    for (const Object& o : objects)
+      for (int k = 0; k < 8; ++k) {
+        const glm::vec3 corner((k & 1) ? o.hi.x : o.lo.x, (k & 2) ? o.hi.y : o.lo.y, (k & 4) ? o.hi.z : o.lo.z);
+        const glm::vec4 clip = vp * o.model * glm::vec4(corner, 1.0f);
+        if (clip.w <= 1e-6f) return image;
+        const float x = (clip.x / clip.w * 0.5f + 0.5f) * float(camera.width);
+        const float y = (clip.y / clip.w * 0.5f + 0.5f) * float(camera.height);  // GL rows, bottom up
+        x0 = std::min(x0, x), x1 = std::max(x1, x), y0 = std::min(y0, y), y1 = std::max(y1, y);
+      }
+    if (x1 < x0) return {};
+    const cv::Rect box(cv::Point(int(std::floor(x0)) - 2, int(std::floor(y0)) - 2),
+                       cv::Point(int(std::ceil(x1)) + 3, int(std::ceil(y1)) + 3));
+    return box & image;
+  }
 
   CameraIntrinsics camera;
   GlName empty_vertex_array;  // core profile needs one bound even for attribute-less draws
-  GlName background, depth_only, shaded_object, world_position, room_radiance, encode, blur;
+  GlName background, depth_only, shaded_object, world_position, room_radiance, encode, blur, covered, antialias_resolve;
   GpuMesh room;
   std::unique_ptr<ShadowPass> receivers;  // shadow receivers, drawn over the video
   std::vector<Object> objects;
@@ -150,7 +172,8 @@ struct Renderer::Impl {
   glm::mat3 map_from_world{1.0f};
 
   RenderTarget scene;                  // linear colour (RGBA32F) and depth, output size
-  MultisampleTarget multisampled;      // the same, antialiased; resolved into `scene`
+  MultisampleTarget multisampled;      // the objects' coverage, 4 samples per pixel
+  RenderTarget coverage, antialiased;  // its resolve (R8), and the scene antialiased by it
   RenderTarget blurred_rows, blurred;  // the blur's two passes (RGBA32F)
   RenderTarget encoded;                // sRGB 8-bit, output size, rows flipped for read-back
   RenderTarget room_target;            // for render_room_radiance, resized on demand
@@ -218,6 +241,50 @@ struct Renderer::Impl {
     upload_bgr8(video.get(), frame);
   }
 
+  // Antialiasing of `scene` at the cost of one shaded sample per pixel: the objects' coverage of
+  // each pixel from a multisampled pass that only rasterises (the proxy's depth, then the
+  // objects with a constant colour), then each outline pixel mixes the object's and the
+  // video's colours by that coverage, the kind its centre missed taken from its 3x3
+  // neighbours. Shading every sample instead costs llvmpipe five times the objects' time.
+  // Only within the objects' footprint: multisampled passes are dear on a software rasteriser.
+  GLuint antialias(const glm::mat4& vp) {
+    if (coverage.width != camera.width || coverage.height != camera.height) {
+      coverage = RenderTarget(camera.width, camera.height, GL_R8, false, "the objects' coverage");
+      antialiased = RenderTarget(camera.width, camera.height, GL_RGBA32F, false, "the antialiased scene");
+    }
+    const cv::Rect box = objects_footprint(vp);
+    coverage.begin();  // zero outside the footprint
+    if (!box.empty()) {
+      glEnable(GL_SCISSOR_TEST);
+      glScissor(box.x, box.y, box.width, box.height);
+      multisampled.begin();  // clears within the scissor only
+      glEnable(GL_DEPTH_TEST);
+      glDepthFunc(GL_LESS);
+      glDepthMask(GL_TRUE);
+      draw_room_depth(vp);
+      draw_objects(covered.get(), vp, false, 0.0f);
+      glDisable(GL_DEPTH_TEST);
+      glDisable(GL_SCISSOR_TEST);
+      glBlitNamedFramebuffer(multisampled.framebuffer.get(), coverage.framebuffer.get(), box.x, box.y,
+                             box.x + box.width, box.y + box.height, box.x, box.y, box.x + box.width, box.y + box.height,
+                             GL_COLOR_BUFFER_BIT, GL_NEAREST);
+    }
+    // The scene as it is, then the outline pixels within the footprint mixed anew.
+    glBlitNamedFramebuffer(scene.framebuffer.get(), antialiased.framebuffer.get(), 0, 0, camera.width, camera.height, 0,
+                           0, camera.width, camera.height, GL_COLOR_BUFFER_BIT, GL_NEAREST);
+    if (box.empty()) return antialiased.color.get();
+    glBindFramebuffer(GL_FRAMEBUFFER, antialiased.framebuffer.get());
+    glViewport(0, 0, camera.width, camera.height);
+    glEnable(GL_SCISSOR_TEST);
+    glScissor(box.x, box.y, box.width, box.height);
+    glUseProgram(antialias_resolve.get());
+    glBindTextureUnit(shaders::kLinearImageUnit, scene.color.get());
+    glBindTextureUnit(shaders::kCoverageUnit, coverage.color.get());
+    draw_fullscreen();
+    glDisable(GL_SCISSOR_TEST);
+    return antialiased.color.get();
+  }
+
   // The camera's blur on what was rendered: a separable Gaussian of `linear` (rows, then
   // columns), kept only where it reaches a rendered pixel (alpha > 0); the video
   // elsewhere has the camera's blur already. Returns the blurred image's texture.
@@ -272,12 +339,14 @@ Renderer::Renderer(const CameraIntrinsics& camera) : impl_(std::make_unique<Impl
   r.room_radiance = create_program("room radiance", kMeshVertex, kRoomRadianceFragment);
   r.encode = create_program("sRGB encode", kFullscreenVertex, kEncodeFragment);
   r.blur = create_program("camera blur", kFullscreenVertex, kBlurFragment);
+  r.covered = create_program("object coverage", kMeshVertex, kCoveredFragment);
+  r.antialias_resolve = create_program("antialiasing", kFullscreenVertex, kAntialiasFragment);
   r.scene = RenderTarget(camera.width, camera.height, GL_RGBA32F, true, "the linear scene");
   r.encoded = RenderTarget(camera.width, camera.height, GL_RGBA8, false, "the encoded output");
   GLint max_samples = 0;
   glGetIntegerv(GL_MAX_SAMPLES, &max_samples);
   if (max_samples >= 2)
-    r.multisampled = MultisampleTarget(camera.width, camera.height, std::min(4, int(max_samples)), GL_RGBA32F);
+    r.multisampled = MultisampleTarget(camera.width, camera.height, std::min(4, int(max_samples)), GL_R8);
   check_gl_errors("Renderer::Renderer");
 }
 
@@ -322,6 +391,7 @@ void Renderer::set_environment(const EnvironmentMap& map) {
 int Renderer::add_object(const Mesh& mesh_model) {
   Impl::Object o;
   o.mesh = GpuMesh(mesh_model, "virtual object mesh");
+  std::tie(o.lo, o.hi) = mesh_model.bounds();
   if (mesh_model.normals.empty() && !mesh_model.indices.empty())
     throw InputError("Renderer::add_object: the virtual object mesh has no normals; load it with load_mesh");
   o.mesh.set_light_attenuation(std::vector<glm::vec3>(mesh_model.positions.size(), glm::vec3(1.0f)));
@@ -453,13 +523,8 @@ cv::Mat Renderer::render_overlay(const cv::Mat& video_bgr8, const std::optional<
   r.upload_video(video_bgr8);
   clock.mark(&t.upload_ms);
 
-  // Background: the undistorted video, decoded to linear light. With antialiasing every
-  // pass draws into the multisampled target, resolved into `scene` before the encode.
-  const bool antialias = r.features.antialiasing && r.multisampled.samples > 1 && T_world_camera;
-  if (antialias)
-    r.multisampled.begin();
-  else
-    r.scene.begin();
+  // Background: the undistorted video, decoded to linear light.
+  r.scene.begin();
   glDisable(GL_DEPTH_TEST);
   glDisable(GL_BLEND);
   const GLuint bg = r.background.get();
@@ -494,12 +559,13 @@ cv::Mat Renderer::render_overlay(const cv::Mat& video_bgr8, const std::optional<
     glDepthMask(GL_TRUE);
     glDepthFunc(GL_LESS);
     glDisable(GL_DEPTH_TEST);
-    if (antialias)
-      glBlitNamedFramebuffer(r.multisampled.framebuffer.get(), r.scene.framebuffer.get(), 0, 0, r.camera.width,
-                             r.camera.height, 0, 0, r.camera.width, r.camera.height, GL_COLOR_BUFFER_BIT, GL_NEAREST);
     clock.mark(&t.objects_ms);
   }
   GLuint linear_image = r.scene.color.get();
+  if (T_world_camera && r.features.antialiasing && r.multisampled.samples > 1) {
+    linear_image = r.antialias(Impl::view_projection(r.camera, *T_world_camera));
+    clock.mark(&t.antialiasing_ms);
+  }
   if (T_world_camera && r.features.blur && r.blur_sigma > 0.0f) {
     linear_image = r.blur_rendered(linear_image);
     clock.mark(&t.blur_ms);

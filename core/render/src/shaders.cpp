@@ -229,4 +229,45 @@ void main() {
 }
 )glsl";
 
+const char* const kCoveredFragment = R"glsl(
+#version 450 core
+out vec4 color;
+void main() { color = vec4(1.0); }
+)glsl";
+
+const char* const kAntialiasFragment = R"glsl(
+#version 450 core
+layout(binding = 3) uniform sampler2D linear_image;  // one sample per pixel; alpha 1: object
+layout(binding = 7) uniform sampler2D coverage;      // the objects' share of each pixel
+out vec4 color;
+void main() {
+  ivec2 p = ivec2(gl_FragCoord.xy), size = textureSize(linear_image, 0);
+  vec4 here = texelFetch(linear_image, p, 0);
+  float c = texelFetch(coverage, p, 0).r;
+  bool object_here = here.a > 0.5;
+  if ((object_here && c >= 1.0) || (!object_here && c <= 0.0)) {
+    color = here;
+    return;
+  }
+  // The pixel's centre shows one kind; the other kind's colour is its neighbours'.
+  vec3 object = vec3(0.0), video = vec3(0.0);
+  float objects = 0.0, videos = 0.0;
+  for (int dy = -1; dy <= 1; ++dy)
+    for (int dx = -1; dx <= 1; ++dx) {
+      vec4 q = texelFetch(linear_image, clamp(p + ivec2(dx, dy), ivec2(0), size - 1), 0);
+      if (q.a > 0.5) {
+        object += q.rgb;
+        objects += 1.0;
+      } else {
+        video += q.rgb;
+        videos += 1.0;
+      }
+    }
+  vec3 o = object_here ? here.rgb : object / max(objects, 1.0);
+  vec3 v = object_here ? (videos > 0.0 ? video / videos : here.rgb) : here.rgb;
+  if (!object_here && objects == 0.0) o = here.rgb;
+  color = vec4(mix(v, o, c), c);
+}
+)glsl";
+
 }  // namespace lumar::gl::shaders

@@ -15,11 +15,15 @@ extern const char* const kWorldPositionFragment;  // (x, y, z, 1)
 extern const char* const kRoomRadianceFragment;   // environment map projected from its capture point
 extern const char* const kEncodeFragment;         // linear -> sRGB, rows flipped for read-back; the camera's noise
 extern const char* const kBlurFragment;           // one pass of the camera's blur on rendered pixels
+extern const char* const kCoveredFragment;        // 1: where an object is (its coverage, multisampled)
+extern const char* const kAntialiasFragment;      // outline pixels mixed by the objects' coverage
 
 constexpr int kVideoUnit = 0, kUndistortionMapUnit = 1, kEnvironmentUnit = 2, kLinearImageUnit = 3;
 // The camera response as look-up tables (Renderer::set_video_radiometry).
 constexpr int kResponseDecodeUnit = 4, kResponseEncodeUnit = 5;
 // The blur's input of this pass (the first pass's is the linear image itself).
 constexpr int kBlurSourceUnit = 6;
+// The objects' coverage per pixel (R8), for the antialiasing pass.
+constexpr int kCoverageUnit = 7;
 
 }  // namespace lumar::gl::shaders

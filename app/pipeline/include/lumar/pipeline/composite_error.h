@@ -32,6 +32,9 @@ struct CompositeError {
   double object_err = 0, edge_err = 0, shadow_err = 0;  // percent of the region's mean truth
   double noise_ratio = 0;
   double noise_floor_object_err = 0, noise_floor_edge_err = 0, noise_floor_shadow_err = 0;
+  // Isolated dark pixels of the composite inside the mask (below a quarter of their 3×3
+  // median, full resolution) that the truth does not have: an open scan's holes.
+  std::int64_t specks = 0;
 };
 
 class CompositeErrorMeter {
@@ -57,6 +60,7 @@ class CompositeErrorMeter {
   std::array<Sums, 3> composite_{}, floor_{};  // per region
   std::array<std::int64_t, 3> pixels_{};
   double residual_composite_ = 0, residual_truth_ = 0;
+  std::int64_t specks_ = 0;
   int frames_ = 0;
 };
 

@@ -30,7 +30,7 @@ namespace lumar::gl {
 // Wall time of each stage of render_overlay. Asking for timings makes the stages wait
 // for each other (glFinish between them), so ask only when profiling.
 struct OverlayTimings {
-  double upload_ms = 0, background_ms = 0, depth_ms = 0, objects_ms = 0, blur_ms = 0, readback_ms = 0;
+  double upload_ms = 0, background_ms = 0, depth_ms = 0, objects_ms = 0, antialiasing_ms = 0, blur_ms = 0, readback_ms = 0;
 };
 
 // How the camera turned light into video, so that rendered pixels look like the
@@ -54,7 +54,7 @@ struct VideoRadiometry {
 // What makes rendered pixels look like the camera's own around them (docs/ground_truth.md,
 // "What closes the gap"); each can be switched off to measure what it brings.
 struct CompositeFeatures {
-  bool antialiasing = true;    // four samples per pixel (MSAA) on the objects' edges
+  bool antialiasing = true;    // the objects' coverage of outline pixels, from 4 samples (MSAA)
   bool self_occlusion = true;  // the objects' baked occlusion of themselves
   bool noise = true;           // VideoRadiometry's noise on rendered pixels
   bool blur = true;            // VideoRadiometry's blur on rendered pixels and their edges

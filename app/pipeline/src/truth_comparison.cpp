@@ -1,0 +1,52 @@
+#include "lumar/pipeline/truth_comparison.h"
+
+#include <fmt/format.h>
+
+#include <opencv2/imgcodecs.hpp>
+
+#include "lumar/base/error.h"
+#include "lumar/calib/undistortion.h"
+
+namespace lumar::pipeline {
+
+std::optional<TruthComparison> compare_with_truth(const std::filesystem::path& dir, ReplayOverlaySettings settings,
+                                                  const TruthFrameVisitor& visit) {
+  const std::filesystem::path truth = dir / "truth";
+  if (!std::filesystem::is_directory(truth)) return std::nullopt;
+  settings.poses = PoseSource::Truth;
+  ReplayOverlay overlay(dir, settings);
+  const capture::Session& session = overlay.replay().session();
+  const calib::UndistortionMaps maps = calib::make_undistortion_maps(session.camera, settings.overlay.undistortion);
+  CompositeErrorMeter meter(calib::calibrated_response(session.radiometry, dir).value_or(calib::srgb_response(1.0)));
+  const auto read = [&](const char* kind, std::int64_t index, int flags) {
+    const std::filesystem::path file = truth / fmt::format("{}-{:05d}.png", kind, index);
+    const cv::Mat image = cv::imread(file.string(), flags);
+    if (image.empty()) throw InputError(file.string() + ": missing or unreadable truth frame");
+    if (image.size() != maps.map_x.size())
+      throw InputError(file.string() + ": truth frame is " + std::to_string(image.cols) + "x" +
+                       std::to_string(image.rows) + ", not the video's size");
+    return calib::undistort_image(image, maps);
+  };
+  const auto total_ms = [&] {
+    const StageTimes& t = overlay.overlay().times();
+    return t.decode + t.pose + t.lighting + t.upload + t.background + t.depth + t.objects + t.antialiasing + t.blur +
+           t.readback + t.output;
+  };
+  // The first frame pays for the shaders' compilation: timed from the second on.
+  double after_first = 0;
+  int frames = 0;
+  overlay.run(0, [&](const OverlayFrame& f) {
+    if (frames++ == 0) after_first = total_ms();
+    if (!f.T_world_camera) return true;
+    const cv::Mat mask = read("mask", f.index, cv::IMREAD_GRAYSCALE) > 127;
+    const cv::Mat frame = read("frame", f.index, cv::IMREAD_COLOR);
+    meter.add(f.composite, frame, read("other-seed", f.index, cv::IMREAD_COLOR),
+              read("empty", f.index, cv::IMREAD_COLOR), mask);
+    if (visit) visit(f, frame, mask);
+    return true;
+  });
+  const double ms = frames > 1 ? (total_ms() - after_first) / (frames - 1) : total_ms();
+  return TruthComparison{meter.result(), ms};
+}
+
+}  // namespace lumar::pipeline

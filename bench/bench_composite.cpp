@@ -1,0 +1,116 @@
+// The composite against its ground truth for every combination of the features that make
+// rendered pixels look like the camera's (antialiasing, self-occlusion, noise, blur:
+// docs/ground_truth.md): each region's error against milliseconds per frame, through the
+// pipeline library `lumar regress` runs. Baseline: every feature off, in the same run
+// (the 2004 system's look: no antialiasing, no self-occlusion). Writes
+// docs/composite_error_vs_cost.png (object, edge and shadow side by side) and
+// docs/composite_before_after_truth.png (crops at the figurine's feet: every feature off,
+// every feature on, the truth).
+#include <spdlog/spdlog.h>
+
+#include <unistd.h>
+
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "bench_report.h"
+#include "lumar/calib/camera_file.h"
+#include "lumar/calib/image_file.h"
+#include "lumar/pipeline/truth_comparison.h"
+#include "lumar/sim/synthetic_recording.h"
+
+using namespace lumar;
+namespace fs = std::filesystem;
+
+namespace {
+
+const fs::path kSource = LUMAR_SOURCE_DIR;
+
+std::string name_of(const gl::CompositeFeatures& f) {
+  std::string name;
+  const auto add = [&](bool on, const char* what) {
+    if (on) name += (name.empty() ? "" : "+") + std::string(what);
+  };
+  add(f.antialiasing, "aa");
+  add(f.self_occlusion, "occlusion");
+  add(f.noise, "noise");
+  add(f.blur, "blur");
+  return name.empty() ? "all off" : name;
+}
+
+// The figurine's feet and the floor around them: the bottom 40 % of the mask's box, widened.
+cv::Rect feet(const cv::Mat& truth_mask) {
+  const cv::Rect box = cv::boundingRect(truth_mask);
+  const int h = std::max(40, box.height * 2 / 5);
+  return cv::Rect(box.x - 12, box.y + box.height - h, box.width + 24, h + 12) &
+         cv::Rect(0, 0, truth_mask.cols, truth_mask.rows);
+}
+
+}  // namespace
+
+int main() {
+  // The recording and its truth (about 20 MB) in a temporary folder, not among the results.
+  const fs::path out = fs::temp_directory_path() / fmt::format("lumar-bench-composite-{}", ::getpid());
+  fs::remove_all(out);
+  sim::SynthSettings synth;
+  synth.scene = kSource / "data/scenes/room/scene.json";
+  synth.camera = calib::load_camera_file(kSource / "data/camera/webcam-640x480.yml").intrinsics;
+  synth.out = out;
+  synth.frames = 8;
+  synth.truth = true;
+  spdlog::info("composite bench: rendering {} frames and their truth into {}", synth.frames, out.string());
+  sim::synthesize_recording(synth);
+
+  std::vector<bench::BenchReport> reports(3);
+  const char* regions[3] = {"object", "edge", "shadow"};
+  for (int k = 0; k < 3; ++k) {
+    reports[std::size_t(k)].name = std::string("composite_error_") + regions[k];
+    reports[std::size_t(k)].title = std::string("Composite vs truth: ") + regions[k] + " region";
+    reports[std::size_t(k)].baseline = "all off";
+    reports[std::size_t(k)].error_label = std::string(regions[k]) + " error (% of the truth)";
+    reports[std::size_t(k)].highlight = "aa+occlusion+noise+blur";
+  }
+  cv::Mat before, after, truth, mask;
+  for (int bits = 0; bits < 16; ++bits) {
+    pipeline::ReplayOverlaySettings settings;
+    settings.overlay.features = {bool(bits & 1), bool(bits & 2), bool(bits & 4), bool(bits & 8)};
+    const std::string name = name_of(settings.overlay.features);
+    const auto compared = pipeline::compare_with_truth(
+        out, settings, [&](const pipeline::OverlayFrame& f, const cv::Mat& truth_frame, const cv::Mat& truth_mask) {
+          if (f.index != synth.frames - 1 || (bits != 0 && bits != 15)) return;
+          (bits == 0 ? before : after) = f.composite.clone();
+          truth = truth_frame;
+          mask = truth_mask;
+        });
+    const pipeline::CompositeError& e = compared->error;
+    const double errors[3] = {e.object_err, e.edge_err, e.shadow_err};
+    for (int k = 0; k < 3; ++k) reports[std::size_t(k)].entries.push_back({name, compared->ms_per_frame, errors[k]});
+    spdlog::info("{:<26} {:6.1f} ms/frame  object {:.2f} %  edge {:.2f} %  shadow {:.2f} %  noise ratio {:.2f}", name,
+                 compared->ms_per_frame, e.object_err, e.edge_err, e.shadow_err, e.noise_ratio);
+  }
+  std::vector<cv::Mat> charts;
+  for (auto& r : reports) {
+    r.note = "8 frames of the sample room's orbit with their truth; ms per frame (decode to read-back) on llvmpipe";
+    r.compute_ratios();
+    r.save(bench::results_dir());
+    charts.push_back(cv::imread((bench::results_dir() / (r.name + ".png")).string(), cv::IMREAD_COLOR));
+  }
+  cv::Mat tiled;
+  cv::hconcat(charts, tiled);
+  calib::write_image_atomically(kSource / "docs/composite_error_vs_cost.png", tiled);
+
+  // The last frame's feet, 4 times enlarged: before, after, truth.
+  const cv::Rect crop = feet(mask);
+  std::vector<cv::Mat> parts;
+  for (const cv::Mat& image : {before, after, truth}) {
+    cv::Mat big;
+    cv::resize(image(crop), big, {}, 4, 4, cv::INTER_NEAREST);
+    parts.push_back(big);
+  }
+  cv::Mat picture;
+  cv::hconcat(parts, picture);
+  calib::write_image_atomically(kSource / "docs/composite_before_after_truth.png", picture);
+  fs::remove_all(out);
+  std::printf("wrote docs/composite_error_vs_cost.png and docs/composite_before_after_truth.png\n");
+  return 0;
+}
