@@ -62,6 +62,11 @@ tracking::EmulatorSettings emulator_for(const capture::RecordingReplay& replay) 
 
 double psnr(const cv::Mat& a, const cv::Mat& b) { return std::min(99.0, cv::PSNR(a, b)); }
 
+// These tests compare the two paths' radiometry and lighting; the composite's features
+// (noise, blur, antialiasing, self-occlusion) have their own tests, and off they keep the
+// frame rate, and so what a live source shows under ThreadSanitizer, as it was.
+constexpr gl::CompositeFeatures kNoFeatures{false, false, false, false};
+
 // The live overlay of the recording `dir` played as a camera, posed by the emulator.
 pipeline::LiveOverlayOptions live_options(const std::filesystem::path& dir, const tracking::TrackerEmulator& emulator) {
   pipeline::LiveOverlayOptions lo;
@@ -71,6 +76,7 @@ pipeline::LiveOverlayOptions live_options(const std::filesystem::path& dir, cons
   lo.rig = dir / "session.json";  // rig, camera, radiometry and latency
   lo.max_wait_ms = 200;           // let the tracker connect before the first frames
   lo.overlay.window = false;
+  lo.overlay.features = kNoFeatures;
   return lo;
 }
 
@@ -83,6 +89,7 @@ struct Compared {
 Compared compare_live_with_replay(const std::filesystem::path& dir, int adapt_lighting_every) {
   pipeline::ReplayOverlaySettings rs;
   rs.poses = pipeline::PoseSource::Truth;
+  rs.overlay.features = kNoFeatures;
   rs.overlay.adapt_lighting_every = adapt_lighting_every;
   pipeline::ReplayOverlay replay(dir, rs);
   std::map<std::int64_t, cv::Mat> expected;
@@ -142,6 +149,7 @@ TEST(LiveOverlay, WithoutTheSessionsRadiometryTheFramesDiffer) {
   const std::filesystem::path& dir = still_recording();
   pipeline::ReplayOverlaySettings rs;
   rs.poses = pipeline::PoseSource::Truth;
+  rs.overlay.features = kNoFeatures;
   pipeline::ReplayOverlay replay(dir, rs);
   std::map<std::int64_t, cv::Mat> expected;
   replay.run(0, [&](const pipeline::OverlayFrame& f) {
