@@ -54,11 +54,10 @@ Overlay::Overlay(std::shared_ptr<const LoadedScene> scene, const CameraIntrinsic
   // The renderer's linear unit is the response's (sRGB with gain 1 without one).
   response_ = response.value_or(calib::srgb_response(1.0));
   radiometry_ = renderer_radiometry(radiometry, camera, response);
-  features_ = settings.features;
-  noise_known_ = !features_.noise;
-  blur_known_ = !features_.blur;
+  noise_known_ = !settings.features.noise;
+  blur_known_ = !settings.features.blur;
   if (settings.blur_sigma_px >= 0) radiometry_.blur_sigma_px = settings.blur_sigma_px, blur_known_ = true;
-  compositor_->set_features(features_);
+  compositor_->set_features(settings.features);
   compositor_->renderer().set_video_radiometry(radiometry_);
   if (settings.adapt_lighting_every > 0)
     live_lighting_.emplace(camera, maps, response_, radiometry, settings.adapt_lighting_every);
@@ -86,7 +85,7 @@ void Overlay::measure_camera(const cv::Mat& video) {
   if (!blur_known_) try {
       const calib::CameraBlur blur = calib::estimate_camera_blur(calib::undistort_image(video, maps_));
       // Antialiasing already averages each pixel's area, a box of variance 1/12 px².
-      const double box = features_.antialiasing ? 1.0 / 12.0 : 0.0;
+      const double box = compositor_->renderer().features().antialiasing ? 1.0 / 12.0 : 0.0;
       radiometry_.blur_sigma_px = std::min(4.0, std::sqrt(std::max(0.0, blur.sigma_px * blur.sigma_px - box)));
       blur_known_ = true;
       spdlog::debug("camera blur: sigma {:.2f} px from {} edge pixels", blur.sigma_px, blur.edges);
@@ -136,6 +135,10 @@ OverlayFrame Overlay::composite(const capture::Frame& frame, const std::optional
   return out;
 }
 
+double StageTimes::total() const {
+  return decode + pose + lighting + upload + background + depth + objects + antialiasing + blur + readback + output;
+}
+
 std::string format_stage_times(const StageTimes& t) {
   const int n = std::max(1, t.frames);
   const std::pair<const char*, double> stages[] = {{"decode video", t.decode},
@@ -149,8 +152,7 @@ std::string format_stage_times(const StageTimes& t) {
                                                    {"camera blur", t.blur},
                                                    {"read back", t.readback},
                                                    {"encode output", t.output}};
-  double total = 0;
-  for (const auto& s : stages) total += s.second;
+  const double total = t.total();
   std::string text = fmt::format("{:<24}{:>10}{:>8}\n", "stage", "ms/frame", "share");
   for (const auto& [name, ms] : stages)
     text += fmt::format("{:<24}{:>10.2f}{:>7.1f}%\n", name, ms / n, total > 0 ? 100.0 * ms / total : 0.0);

@@ -34,9 +34,10 @@ struct OverlaySettings {
 };
 
 struct StageTimes {  // milliseconds, summed over frames
-  double decode = 0, pose = 0, lighting = 0, upload = 0, background = 0, depth = 0, objects = 0, antialiasing = 0, blur = 0, readback = 0,
-         output = 0;
+  double decode = 0, pose = 0, lighting = 0, upload = 0, background = 0, depth = 0, objects = 0, antialiasing = 0,
+         blur = 0, readback = 0, output = 0;
   int frames = 0;
+  double total() const;  // every stage
 };
 
 struct OverlayFrame {
@@ -83,7 +84,6 @@ class Overlay {
   calib::UndistortionMaps maps_;
   calib::CameraResponse response_;
   gl::VideoRadiometry radiometry_;
-  gl::CompositeFeatures features_;
   bool noise_known_ = false, blur_known_ = false, warned_ = false;
   std::int64_t frames_seen_ = 0;
   StageTimes times_;
