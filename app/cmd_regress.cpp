@@ -36,7 +36,8 @@ struct RegressOptions {
   double blur_sigma = -1.0;
 };
 
-const cv::Size kGoldenSize(160, 120);
+// Golden frames' size for --update: big enough that a shadow and an edge count.
+const cv::Size kGoldenSize(320, 240);
 
 // Mean distance between where the object's points project with the tracked and the true pose.
 double projection_error_px(const CameraIntrinsics& camera, const std::vector<glm::dvec3>& points, const Pose& tracked,
@@ -108,7 +109,16 @@ Outcome regress_one(const fs::path& dir, const RegressOptions& o) {
                      dir.string());
   json expected = update ? json::object() : read_json_file(expected_file, "expectations file");
   std::vector<std::int64_t> golden;
-  if (!update) golden = expected.at("golden_frames").get<std::vector<std::int64_t>>();
+  cv::Size golden_size = kGoldenSize;
+  if (!update) {
+    golden = expected.at("golden_frames").get<std::vector<std::int64_t>>();
+    if (expected.contains("golden_size")) {
+      const auto wh = expected.at("golden_size").get<std::vector<int>>();
+      if (wh.size() != 2 || wh[0] < 16 || wh[1] < 16 || wh[0] > 4096 || wh[1] > 4096)
+        throw InputError(expected_file.string() + ": golden_size: expected [width, height] from 16 to 4096");
+      golden_size = cv::Size(wh[0], wh[1]);
+    }
+  }
 
   pipeline::ReplayOverlaySettings settings;
   settings.scene = o.scene;
@@ -134,7 +144,7 @@ Outcome regress_one(const fs::path& dir, const RegressOptions& o) {
   overlay.run(0, [&](const pipeline::OverlayFrame& f) {
     if (std::find(golden.begin(), golden.end(), f.index) != golden.end()) {
       cv::Mat small;
-      cv::resize(f.composite, small, kGoldenSize, 0, 0, cv::INTER_AREA);
+      cv::resize(f.composite, small, golden_size, 0, 0, cv::INTER_AREA);
       outputs[f.index] = small;
     }
     const auto truth = overlay.replay().true_camera_pose(f.index);

@@ -129,7 +129,7 @@ int main(int argc, char** argv) {
   if (quick)
     s.reference.assign(s.receivers.positions.size(), glm::vec3(1.0f));
   else {
-    std::vector<ShadowScene::Object> objects{{fig.name, fig.model, error_pose()}};
+    std::vector<ShadowScene::Object> objects{{fig.name, fig.model, error_pose(), glm::vec3(0.8f), {}}};
     EnvironmentMap map = s.scene->map();
     const ShadowScene posed(std::move(map), false, s.scene->room(), std::move(objects));
     s.reference = shadow_attenuation(posed, s.receivers.positions, s.receivers.normals, ShadowMethod::Reference);

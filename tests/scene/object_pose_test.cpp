@@ -1,7 +1,9 @@
 // Object poses in a manifest: the three forms of rotation agree with each other,
 // "bottom-centre" puts the bottom of the rotated model's box at the translation, and
 // "on_floor" rests the lowest point on the proxy surface below (the table top, not the
-// floor, when the object stands over the table).
+// floor, when the object stands over the table). An animated object's "path": its keys
+// reached at their times, straight lines and slerp between them, resting on the floor
+// all the way.
 #include <gtest/gtest.h>
 
 #include <spdlog/sinks/ostream_sink.h>
@@ -26,8 +28,8 @@ class ObjectPose : public ::testing::Test {
     std::filesystem::remove_all(dir_, ignored);
   }
 
-  // The sample room's manifest with its figurine's "pose" replaced.
-  std::filesystem::path manifest(const std::string& pose_json) {
+  // The sample room's manifest with its figurine's "pose" replaced, and a "path" if given.
+  std::filesystem::path manifest(const std::string& pose_json, const std::string& path_json = "") {
     const auto src = test::source_dir() / "data/scenes/room";
     const auto path = dir_ / "scene.json";
     std::ofstream(path) << R"({"format": "lumar-scene", "version": 1,
@@ -40,7 +42,7 @@ class ObjectPose : public ::testing::Test {
       "objects": [{"name": "figurine", "mesh": ")"
                         << (test::source_dir() / "data/models/parasaurolophus_6700.ply").string() << R"(",
                    "pose": )"
-                        << pose_json << "}]}";
+                        << pose_json << (path_json.empty() ? "" : ", \"path\": " + path_json) << "}]}";
     return path;
   }
 
@@ -129,6 +131,92 @@ TEST_F(ObjectPose, StandingOutsideTheMovementBoxOrTheRoomIsWarned) {
   EXPECT_EQ(beyond_box.find("outside the proxy room"), std::string::npos) << beyond_box;
   EXPECT_NE(outside.find("stands outside the movement box"), std::string::npos) << outside;
   EXPECT_NE(outside.find("reaches outside the proxy room"), std::string::npos) << outside;
+}
+
+constexpr const char* kWalkPose =
+    R"({"yaw_pitch_roll_deg": [20, 0, 90], "scale": 0.002, "model_origin": "bottom-centre", "on_floor": true})";
+constexpr const char* kWalkPath = R"([{"t": 0.5, "translation": [-0.8, 0.3, 0.6]},
+      {"t": 1.5, "translation": [-0.2, 0.0, 0.2], "rotation_axis": [0, 1, 0], "rotation_deg": 80}])";
+
+glm::dquat rotation_of(const glm::dmat4& T) {
+  const glm::dmat3 M(T);
+  return glm::normalize(glm::quat_cast(M / glm::length(M[0])));
+}
+
+TEST_F(ObjectPose, PathKeysAreReachedAtTheirTimesAndHeldBeyond) {
+  const LoadedScene s = load_scene_files(manifest(kWalkPose, kWalkPath));
+  const LoadedObject& o = s.objects[0];
+  ASSERT_EQ(o.path.keys().size(), 2u);
+  EXPECT_EQ(o.T_world_model, o.path.keys()[0].T_world_model);  // the still pose is the path's start
+  for (double t : {0.0, 0.5, 1.5, 9.0}) {
+    const LoadedObject at = [&] {
+      LoadedObject c = o;
+      c.T_world_model = o.pose_at(t);
+      return c;
+    }();
+    const auto [lo, hi] = transformed(at.model, at.T_world_model).bounds();
+    const glm::dvec3 want = t < 1.0 ? glm::dvec3(-0.8, 0.0, 0.6) : glm::dvec3(-0.2, 0.0, 0.2);
+    // Bottom-centre lands at the key's translation, brought down onto the floor.
+    EXPECT_NEAR(0.5 * (lo.x + hi.x), want.x, 1e-6) << t;
+    EXPECT_NEAR(lo.y, 0.0, 1e-6) << t;
+    EXPECT_NEAR(0.5 * (lo.z + hi.z), want.z, 1e-6) << t;
+  }
+  // The key's turn comes on top of the pose's rotation: R = Ry(80°) R_pose.
+  const glm::dquat turn = rotation_of(o.pose_at(1.5)) * glm::inverse(rotation_of(o.pose_at(0.5)));
+  EXPECT_NEAR(glm::degrees(glm::angle(turn)), 80.0, 1e-6);
+  EXPECT_NEAR(std::abs(glm::axis(turn).y), 1.0, 1e-9);
+  // Without a path: the pose at every time.
+  const LoadedScene still = load_scene_files(manifest(kWalkPose));
+  EXPECT_TRUE(still.objects[0].path.empty());
+  EXPECT_EQ(still.objects[0].pose_at(3.0), still.objects[0].T_world_model);
+}
+
+TEST_F(ObjectPose, BetweenKeysTheCentreMovesStraightAndTheTurnIsShared) {
+  const LoadedScene s = load_scene_files(manifest(kWalkPose, kWalkPath));
+  const LoadedObject& o = s.objects[0];
+  const auto [mlo, mhi] = o.model.bounds();
+  const glm::dvec4 centre(0.5 * (glm::dvec3(mlo) + glm::dvec3(mhi)), 1.0);
+  const glm::dvec3 a(o.pose_at(0.5) * centre), b(o.pose_at(1.5) * centre);
+  const glm::dquat ra = rotation_of(o.pose_at(0.5));
+  for (double u : {0.1, 0.25, 0.5, 0.9}) {
+    const glm::dmat4 T = o.pose_at(0.5 + u);
+    EXPECT_NEAR(glm::distance(glm::dvec3(T * centre), glm::mix(a, b, u)), 0.0, 1e-9) << u;
+    EXPECT_NEAR(glm::degrees(glm::angle(rotation_of(T) * glm::inverse(ra))), 80.0 * u, 1e-6) << u;
+    EXPECT_NEAR(glm::length(glm::dmat3(T)[0]), 0.002, 1e-12);
+    // Turning about the vertical keeps the lowest point on the floor between the keys.
+    EXPECT_NEAR(transformed(o.model, T).bounds().first.y, 0.0, 1e-6) << u;
+  }
+}
+
+TEST_F(ObjectPose, BadPathsAreRefusedNamingTheKey) {
+  const auto error = [&](const std::string& path) {
+    try {
+      load_scene(manifest(kWalkPose, path));
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_NE(error(R"([{"t": 0, "translation": [0, 0, 0]}])").find("objects[0].path: expected an array of at least 2"),
+            std::string::npos);
+  EXPECT_NE(error(R"([{"t": 1, "translation": [0, 0, 0]}, {"t": 1, "translation": [0, 0, 0]}])")
+                .find("objects[0].path[1].t: must be later than the key before"),
+            std::string::npos);
+  EXPECT_NE(error(R"([{"t": 0}, {"t": 1, "translation": [0, 0, 0]}])").find("path[0].translation: missing"),
+            std::string::npos);
+  EXPECT_NE(error(R"([{"t": 0, "translation": [0, 0, 0], "scale": 2}, {"t": 1, "translation": [0, 0, 0]}])")
+                .find("path[0].scale: unknown key"),
+            std::string::npos);
+  EXPECT_NE(error(R"([{"t": -1, "translation": [0, 0, 0]}, {"t": 1, "translation": [0, 0, 0]}])")
+                .find("path[0].t: expected seconds"),
+            std::string::npos);
+  EXPECT_NE(error(R"([{"t": 0, "translation": [0, 0, 0]}, {"t": 1, "translation": [0, 0, 1e9]}])")
+                .find("path[1].translation: expected coordinates"),
+            std::string::npos);
+  // Off the room: on_floor finds no surface below that key.
+  EXPECT_THROW(load_scene_files(manifest(kWalkPose, R"([{"t": 0, "translation": [0, 0, 0]},
+      {"t": 1, "translation": [50, 0, 0]}])")),
+               InputError);
 }
 
 }  // namespace

@@ -65,8 +65,11 @@ TEST(ShadowAcceptance, SphereAboveSampleFloor) {
   Scene s = load_scene(test::source_dir() / "data/scenes/room/scene.json");
   s.objects.clear();
   ShadowScene base(load_scene_files(s));
-  std::vector<ShadowScene::Object> objects{{"sphere", test::make_sphere({0, 0, 0}, 0.2f, 48, 24),
-                                            glm::translate(glm::dmat4(1.0), glm::dvec3(-0.3, 0.45, 0.4))}};
+  std::vector<ShadowScene::Object> objects{{"sphere",
+                                            test::make_sphere({0, 0, 0}, 0.2f, 48, 24),
+                                            glm::translate(glm::dmat4(1.0), glm::dvec3(-0.3, 0.45, 0.4)),
+                                            glm::vec3(0.8f),
+                                            {}}};
   EnvironmentMap map = base.map();
   const ShadowScene scene(std::move(map), false, base.room(), std::move(objects));
   check_against_reference(scene, floor_points_around(scene, 0.0f, 32), "sphere");
@@ -79,8 +82,11 @@ TEST(ShadowAcceptance, DistantSkyWithSun) {
   EnvironmentMap map = load_environment_map(path);
   Scene s = load_scene(test::source_dir() / "data/scenes/room/scene.json");
   std::vector<ShadowScene::Object> objects{
-      {"figurine", load_mesh(s.objects[0].mesh),
-       glm::translate(glm::dmat4(1.0), glm::dvec3(0, 0.15, 0)) * s.objects[0].T_world_model}};
+      {"figurine",
+       load_mesh(s.objects[0].mesh),
+       glm::translate(glm::dmat4(1.0), glm::dvec3(0, 0.15, 0)) * s.objects[0].T_world_model,
+       glm::vec3(0.8f),
+       {}}};
   const ShadowScene scene(std::move(map), true, test::make_ground(5.0f), std::move(objects));
   check_against_reference(scene, floor_points_around(scene, 0.0f, 32), "sun");
 }

@@ -291,7 +291,7 @@ TEST(ShadowCulling, CandidatesContainEveryBlockedLineUnderASun) {
   const EnvironmentMap sky = test::make_sun_sky(256, 35.0, 60.0, 1.5, 20000.0f);
   Scene s = load_scene(test::source_dir() / "data/scenes/room/scene.json");
   const Mesh fig = load_mesh(s.objects[0].mesh);
-  std::vector<ShadowScene::Object> objects{{"figurine", fig, s.objects[0].T_world_model}};
+  std::vector<ShadowScene::Object> objects{{"figurine", fig, s.objects[0].T_world_model, glm::vec3(0.8f), {}}};
   const ShadowScene scene(sky, true, test::make_ground(5.0f), std::move(objects));
   std::vector<glm::vec3> positions, normals;
   test::floor_grid(-0.2f, 0.3f, 1.0f, 30, 0.0f, positions, normals);

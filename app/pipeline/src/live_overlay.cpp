@@ -51,7 +51,9 @@ LiveOverlay::LiveOverlay(const LiveOverlayOptions& o) {
   auto driver = make_tracker_driver(in, {});
   const auto recorded = recorded_poses_of(in);
 
-  overlay_ = std::make_unique<Overlay>(std::move(scene), camera, radiometry, response, o.overlay);
+  OverlaySettings overlay = o.overlay;
+  overlay.live = true;  // paths play from the first frame
+  overlay_ = std::make_unique<Overlay>(std::move(scene), camera, radiometry, response, overlay);
   LiveLoopSettings settings;
   settings.what = "overlay";
   settings.policy = capture::QueuePolicy::KeepNewest;  // always the freshest picture

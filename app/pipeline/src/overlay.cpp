@@ -34,7 +34,7 @@ gl::VideoRadiometry renderer_radiometry(const capture::Radiometry& radiometry, c
 Overlay::Overlay(std::shared_ptr<const LoadedScene> scene, const CameraIntrinsics& camera,
                  const capture::Radiometry& radiometry, const std::optional<calib::CameraResponse>& response,
                  const OverlaySettings& settings)
-    : exposure_(radiometry.exposure) {
+    : exposure_(radiometry.exposure), live_(settings.live), volume_cache_(settings.volume_cache) {
   if (settings.window) {
     const char* display = std::getenv("DISPLAY");
     if (!display || !*display)
@@ -100,6 +100,23 @@ void Overlay::measure_camera(const cv::Mat& video) {
   compositor_->renderer().set_video_radiometry(radiometry_);
 }
 
+void Overlay::set_scene(std::shared_ptr<const LoadedScene> scene) {
+  context_->make_current();
+  const gl::CompositeFeatures features = compositor_->renderer().features();
+  compositor_.reset();  // its GL objects go first
+  compositor_ = std::make_unique<Compositor>(std::move(scene), maps_.output, maps_.map_x, maps_.map_y, volume_cache_);
+  compositor_->set_features(features);
+  compositor_->renderer().set_video_radiometry(radiometry_);
+}
+
+void Overlay::play_paths(Nanos frame_time) {
+  if (!first_frame_time_) first_frame_time_ = frame_time;
+  const double t_s = nanos_to_seconds(live_ ? frame_time - *first_frame_time_ : frame_time);
+  const auto& objects = compositor_->scene().objects;
+  for (std::size_t i = 0; i < objects.size(); ++i)
+    if (!objects[i].path.empty()) compositor_->set_object_pose(i, objects[i].pose_at(t_s));
+}
+
 Overlay::~Overlay() {
   compositor_.reset();  // GL objects go before their context
   context_.reset();
@@ -115,6 +132,7 @@ OverlayFrame Overlay::composite(const capture::Frame& frame, const std::optional
   // A process may hold several overlays (the benchmark's with and without features),
   // each with its own context: draw in this one's.
   context_->make_current();
+  play_paths(frame.time);
   measure_camera(frame.image);
   if (live_lighting_ && T_world_camera) {
     const auto t0 = std::chrono::steady_clock::now();
@@ -124,6 +142,7 @@ OverlayFrame Overlay::composite(const capture::Frame& frame, const std::optional
   // The map's light scaled as the room changed: the objects' radiance scales with it.
   gl::OverlayTimings gt;
   out.composite = compositor_->composite(frame.image, T_world_camera, exposure_ * out.lighting_scale, &gt);
+  times_.shadows += gt.shadows_ms;
   times_.upload += gt.upload_ms;
   times_.background += gt.background_ms;
   times_.depth += gt.depth_ms;
@@ -136,7 +155,8 @@ OverlayFrame Overlay::composite(const capture::Frame& frame, const std::optional
 }
 
 double StageTimes::total() const {
-  return decode + pose + lighting + upload + background + depth + objects + antialiasing + blur + readback + output;
+  return decode + pose + lighting + shadows + upload + background + depth + objects + antialiasing + blur + readback +
+         output;
 }
 
 std::string format_stage_times(const StageTimes& t) {
@@ -144,6 +164,7 @@ std::string format_stage_times(const StageTimes& t) {
   const std::pair<const char*, double> stages[] = {{"decode video", t.decode},
                                                    {"tracker pose", t.pose},
                                                    {"lighting adaptation", t.lighting},
+                                                   {"shadows (moved objects)", t.shadows},
                                                    {"upload frame", t.upload},
                                                    {"background (undistort)", t.background},
                                                    {"proxy depth", t.depth},

@@ -28,6 +28,11 @@ ReplayOverlay::ReplayOverlay(const std::filesystem::path& recording, const Repla
                                        calib::calibrated_response(session.radiometry, recording), settings.overlay);
 }
 
+std::optional<Pose> ReplayOverlay::camera_pose(const capture::Frame& frame) const {
+  return pose_source_ == PoseSource::Truth ? replay_.true_camera_pose(frame.index)
+                                           : replay_.tracked_camera_pose(frame.time);
+}
+
 void ReplayOverlay::run(int max_frames, const std::function<bool(const OverlayFrame&)>& sink) {
   auto frames = replay_.open_frames();
   StageTimes& times = overlay_->times();
@@ -38,8 +43,7 @@ void ReplayOverlay::run(int max_frames, const std::function<bool(const OverlayFr
     times.decode += ms_since(t0);
 
     t0 = std::chrono::steady_clock::now();
-    const std::optional<Pose> pose = pose_source_ == PoseSource::Truth ? replay_.true_camera_pose(frame.index)
-                                                                       : replay_.tracked_camera_pose(frame.time);
+    const std::optional<Pose> pose = camera_pose(frame);
     times.pose += ms_since(t0);
 
     const OverlayFrame out = overlay_->composite(frame, pose);

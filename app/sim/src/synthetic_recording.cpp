@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
+#include <algorithm>
 #include <cmath>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgcodecs.hpp>
@@ -144,8 +145,15 @@ cv::Mat compress_like_video(const cv::Mat& frame, const SynthSettings& s) {
 // world bounding box, at its lowest point), else the middle of the movement box.
 glm::dvec3 scene_target(const LoadedScene& scene) {
   if (scene.objects.empty()) return 0.5 * (scene.manifest.movement_min + scene.manifest.movement_max);
+  // An animated object: the middle of the ground its path covers.
   const LoadedObject& object = scene.objects.front();
-  const auto [lo, hi] = transformed(object.model, object.T_world_model).bounds();
+  glm::dvec3 lo(1e300), hi(-1e300);
+  const auto cover = [&](const glm::dmat4& T) {
+    const auto [a, b] = transformed(object.model, T).bounds();
+    lo = glm::min(lo, glm::dvec3(a)), hi = glm::max(hi, glm::dvec3(b));
+  };
+  cover(object.T_world_model);
+  for (const ObjectPath::Key& key : object.path.keys()) cover(key.T_world_model);
   return {0.5 * (lo.x + hi.x), lo.y, 0.5 * (lo.z + hi.z)};
 }
 
@@ -247,6 +255,8 @@ void synthesize_recording(const SynthSettings& s) {
     truth_room = scene_radiance(scene, radiance);
     truth = std::make_unique<CompositeReference>(*truth_room, scene.objects);
   }
+  const bool animated =
+      std::any_of(scene.objects.begin(), scene.objects.end(), [](const LoadedObject& o) { return !o.path.empty(); });
   cv::RNG other_seed(s.truth_seed != 0 ? s.truth_seed : s.seed + 1);
   TruthSettings truth_settings;
   truth_settings.ratio_stride = s.truth_ratio_stride;
@@ -255,12 +265,17 @@ void synthesize_recording(const SynthSettings& s) {
       .codec = s.codec, .quality = s.quality, .fps = s.fps, .size = cv::Size(s.camera.width, s.camera.height)};
   write_synthetic_recording(
       s.out, session, tracker, video, s.frames, s.seed, [&](int k) { return start + frame_period * k; }, true_camera,
-      [&](int k, Nanos, const Pose& T_world_camera, cv::RNG& rng) {
+      [&](int k, Nanos t, const Pose& T_world_camera, cv::RNG& rng) {
         const cv::Mat radiance = renderer.render_room_radiance(pinhole, T_world_camera);
         // The video's own noise, drawn again for the truth, so that only the objects differ.
         cv::RNG same_noise = rng;
         const cv::Mat video = expose(calib::distort_image(radiance, pinhole, s.camera), s.camera, s, exposure, rng);
         if (truth) {
+          if (animated) {  // the objects where their paths are at this frame
+            std::vector<LoadedObject> posed = scene.objects;
+            for (LoadedObject& o : posed) o.T_world_model = o.pose_at(nanos_to_seconds(t));
+            truth = std::make_unique<CompositeReference>(*truth_room, posed);
+          }
           const TruthFrame frame = render_truth_frame(*truth, pinhole, T_world_camera, radiance, truth_settings);
           const cv::Mat seen = calib::distort_image(frame.radiance, pinhole, s.camera);
           const std::filesystem::path dir = s.out / "truth";

@@ -38,12 +38,21 @@ Compositor::Compositor(std::shared_ptr<const LoadedScene> scene, const CameraInt
     // Every k-th vertex, so that checks see the whole object at a bounded cost.
     const Mesh& mesh = object.model;
     const std::size_t step = std::max<std::size_t>(1, mesh.positions.size() / 200);
+    poses_.push_back(object.T_world_model);
+    sampled_points_.emplace_back();
     for (std::size_t i = 0; i < mesh.positions.size(); i += step)
-      object_points_.push_back(glm::dvec3(object.T_world_model * glm::dvec4(glm::dvec3(mesh.positions[i]), 1.0)));
+      sampled_points_.back().emplace_back(mesh.positions[i]);
     spdlog::debug("object '{}': {} triangles", object.name, mesh.triangle_count());
   }
+  pose_object_points();
   build_shadows();
   set_features(renderer_->features());
+}
+
+void Compositor::pose_object_points() {
+  object_points_.clear();
+  for (std::size_t i = 0; i < poses_.size(); ++i)
+    for (const glm::dvec3& p : sampled_points_[i]) object_points_.push_back(glm::dvec3(poses_[i] * glm::dvec4(p, 1.0)));
 }
 
 void Compositor::bake_self_occlusion_once() {
@@ -94,6 +103,9 @@ void Compositor::build_shadows() {
 }
 
 void Compositor::set_object_pose(std::size_t index, const glm::dmat4& T_world_model) {
+  if (poses_.at(index) == T_world_model) return;
+  poses_[index] = T_world_model;
+  pose_object_points();
   renderer_->set_object_pose(int(index), T_world_model);
   if (shadows_) shadows_->set_object_pose(int(index), T_world_model);
   if (object_shadows_) object_shadows_->set_object_pose(int(index), T_world_model);
@@ -116,6 +128,7 @@ void Compositor::set_shadows_enabled(bool on) {
 
 cv::Mat Compositor::composite(const cv::Mat& video_bgr8, const std::optional<Pose>& T_world_camera, double exposure,
                               gl::OverlayTimings* timings) {
+  const auto t0 = std::chrono::steady_clock::now();
   if (shadows_ && shadows_enabled_ && (shadows_->update() || !shadows_uploaded_)) {
     renderer_->set_receiver_attenuation(shadows_->attenuation());
     shadows_uploaded_ = true;
@@ -124,6 +137,10 @@ cv::Mat Compositor::composite(const cv::Mat& video_bgr8, const std::optional<Pos
     for (std::size_t i = 0; i < object_shadows_->object_count(); ++i)
       renderer_->set_object_light_attenuation(int(i), object_shadows_->vertex_attenuation(int(i)));
     object_shadows_uploaded_ = true;
+  }
+  if (timings) {
+    *timings = {};
+    timings->shadows_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   }
   return renderer_->render_overlay(video_bgr8, T_world_camera, exposure, timings);
 }

@@ -518,6 +518,7 @@ cv::Mat Renderer::render_overlay(const cv::Mat& video_bgr8, const std::optional<
     throw InputError("Renderer::render_overlay: video frame must be non-empty BGR8 (CV_8UC3); convert it first");
   Impl& r = *impl_;
   OverlayTimings t;
+  if (timings) t.shadows_ms = timings->shadows_ms;  // the compositor's, before this call
   StageClock clock(timings != nullptr);
 
   r.upload_video(video_bgr8);

@@ -49,25 +49,29 @@ bool inside(const glm::dvec3& lo, const glm::dvec3& hi, const glm::dvec3& box_lo
 }
 
 // The object's final pose: a bottom-centre origin and on_floor need its mesh and the
-// proxy. Warns when it stands outside the movement box (its lighting is extrapolated
-// there) or outside the room.
-glm::dmat4 finish_pose(const Scene& manifest, std::size_t index, const SceneObject& o, const Mesh& model,
-                       const Mesh& room) {
-  glm::dmat4 T = o.T_world_model;
-  const std::string key = manifest.manifest.string() + ": objects[" + std::to_string(index) + "] (" + o.name + ")";
-  if (!o.pose.model_origin) {
+// proxy. `key`: the manifest key named in errors.
+glm::dmat4 finish_pose(const ObjectPose& pose, const Mesh& model, const Mesh& room, const std::string& key) {
+  glm::dmat4 T = pose_matrix(pose);
+  if (!pose.model_origin) {
     // The middle of the bottom of the rotated, scaled model's box lands at `translation`.
-    const glm::dmat4 RS = glm::mat4_cast(o.pose.rotation) * glm::scale(glm::dmat4(1.0), glm::dvec3(o.pose.scale));
+    const glm::dmat4 RS = glm::mat4_cast(pose.rotation) * glm::scale(glm::dmat4(1.0), glm::dvec3(pose.scale));
     const auto [lo, hi] = posed_bounds(model, RS);
     const glm::dvec3 bottom_centre(0.5 * (lo.x + hi.x), lo.y, 0.5 * (lo.z + hi.z));
-    T = glm::translate(glm::dmat4(1.0), o.pose.translation - bottom_centre) * RS;
+    T = glm::translate(glm::dmat4(1.0), pose.translation - bottom_centre) * RS;
   }
-  if (o.pose.on_floor) {
+  if (pose.on_floor) {
     const auto [lo, hi] = posed_bounds(model, T);
     const auto y = surface_below(room, 0.5 * (lo.x + hi.x), 0.5 * (lo.z + hi.z), hi.y);
-    if (!y) throw InputError(key + ": pose.on_floor: no proxy surface below the object; move it over the floor");
+    if (!y) throw InputError(key + ": on_floor: no proxy surface below the object; move it over the floor");
     T = glm::translate(glm::dmat4(1.0), glm::dvec3(0.0, *y - lo.y, 0.0)) * T;
   }
+  return T;
+}
+
+// Warns when an object stands outside the movement box (its lighting is extrapolated
+// there) or outside the room.
+void warn_if_outside(const Scene& manifest, const Mesh& model, const glm::dmat4& T, const Mesh& room,
+                     const std::string& key) {
   const auto [lo, hi] = posed_bounds(model, T);
   if (!inside(lo, hi, manifest.movement_min, manifest.movement_max, 1e-3))
     spdlog::warn("{}: stands outside the movement box, where its lighting is extrapolated", key);
@@ -76,7 +80,26 @@ glm::dmat4 finish_pose(const Scene& manifest, std::size_t index, const SceneObje
     if (!inside(lo, hi, glm::dvec3(room_lo), glm::dvec3(room_hi), 1e-3))
       spdlog::warn("{}: reaches outside the proxy room", key);
   }
-  return T;
+}
+
+// The object's pose and its path's keys, finished.
+void place_object(const Scene& manifest, std::size_t index, const SceneObject& o, const Mesh& room,
+                  LoadedObject& object) {
+  const std::string key = manifest.manifest.string() + ": objects[" + std::to_string(index) + "] (" + o.name + ")";
+  std::vector<ObjectPath::Key> keys;
+  for (std::size_t k = 0; k < o.path.size(); ++k) {
+    const std::string key_k = key + ": path[" + std::to_string(k) + "]";
+    keys.push_back({o.path[k].t_s, finish_pose(o.path[k].pose, object.model, room, key_k)});
+    warn_if_outside(manifest, object.model, keys.back().T_world_model, room, key_k);
+  }
+  if (keys.empty()) {
+    object.T_world_model = finish_pose(o.pose, object.model, room, key + ": pose");
+    warn_if_outside(manifest, object.model, object.T_world_model, room, key);
+    return;
+  }
+  const auto [lo, hi] = object.model.bounds();
+  object.path = ObjectPath(std::move(keys), 0.5 * (glm::dvec3(lo) + glm::dvec3(hi)));
+  object.T_world_model = object.path.keys().front().T_world_model;
 }
 
 }  // namespace
@@ -94,12 +117,12 @@ LoadedScene load_scene_files(const Scene& manifest) {
   out.objects.reserve(manifest.objects.size());  // the pointers above stay valid
   for (std::size_t i = 0; i < manifest.objects.size(); ++i) {
     const SceneObject& o = manifest.objects[i];
-    LoadedObject object{o.name, {}, o.T_world_model, o.albedo};
+    LoadedObject object{o.name, {}, o.T_world_model, o.albedo, {}};
     if (const auto it = decoded.find(o.mesh); it != decoded.end())
       object.model = *it->second;
     else
       object.model = load_mesh(o.mesh);
-    object.T_world_model = finish_pose(manifest, i, o, object.model, out.room);
+    place_object(manifest, i, o, out.room, object);
     out.objects.push_back(std::move(object));
     decoded.emplace(o.mesh, &out.objects.back().model);
   }

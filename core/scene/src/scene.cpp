@@ -138,35 +138,44 @@ std::string fmt_number(double v) {
 
 json parse_manifest(const std::filesystem::path& manifest) { return read_json_file(manifest, "scene manifest"); }
 
-// "pose": translation, one of rotation_axis + rotation_deg | yaw_pitch_roll_deg |
-// rotation_wxyz, scale, model_origin ([x, y, z] or "bottom-centre"), on_floor.
-ObjectPose read_pose(const ManifestReader& r, const json& pose, const std::string& pk) {
-  r.only_keys(pose, pk,
-              {"translation", "rotation_axis", "rotation_deg", "yaw_pitch_roll_deg", "rotation_wxyz", "scale",
-               "model_origin", "on_floor"});
-  ObjectPose p;
-  p.translation = r.position_or(pose, pk, "translation", p.translation);
-  const bool axis_angle = pose.contains("rotation_axis") || pose.contains("rotation_deg");
-  const int forms = int(axis_angle) + int(pose.contains("yaw_pitch_roll_deg")) + int(pose.contains("rotation_wxyz"));
+// One rotation, given as rotation_axis + rotation_deg | yaw_pitch_roll_deg |
+// rotation_wxyz; `fallback` when none is given.
+glm::dquat read_rotation(const ManifestReader& r, const json& v, const std::string& pk, const glm::dquat& fallback) {
+  const bool axis_angle = v.contains("rotation_axis") || v.contains("rotation_deg");
+  const int forms = int(axis_angle) + int(v.contains("yaw_pitch_roll_deg")) + int(v.contains("rotation_wxyz"));
   if (forms > 1) r.fail(pk, "give one rotation: rotation_axis and rotation_deg, yaw_pitch_roll_deg, or rotation_wxyz");
   if (axis_angle) {
-    const glm::dvec3 axis = r.vec3_or(pose, pk, "rotation_axis", glm::dvec3(0.0, 1.0, 0.0));
+    const glm::dvec3 axis = r.vec3_or(v, pk, "rotation_axis", glm::dvec3(0.0, 1.0, 0.0));
     if (glm::length(axis) < 1e-9) r.fail(pk + ".rotation_axis", "must not be the zero vector");
-    p.rotation = axis_angle_deg(axis, r.number_or(pose, pk, "rotation_deg", 0.0));
-  } else if (pose.contains("yaw_pitch_roll_deg")) {
+    return axis_angle_deg(axis, r.number_or(v, pk, "rotation_deg", 0.0));
+  }
+  if (v.contains("yaw_pitch_roll_deg")) {
     // Yaw about world +Y (up), then pitch about +X, then roll about +Z: R = Ry Rx Rz.
-    const glm::dvec3 a = r.vec3(pose.at("yaw_pitch_roll_deg"), pk + ".yaw_pitch_roll_deg");
-    p.rotation = axis_angle_deg({0, 1, 0}, a.x) * axis_angle_deg({1, 0, 0}, a.y) * axis_angle_deg({0, 0, 1}, a.z);
-  } else if (pose.contains("rotation_wxyz")) {
-    const json& q = pose.at("rotation_wxyz");
+    const glm::dvec3 a = r.vec3(v.at("yaw_pitch_roll_deg"), pk + ".yaw_pitch_roll_deg");
+    return axis_angle_deg({0, 1, 0}, a.x) * axis_angle_deg({1, 0, 0}, a.y) * axis_angle_deg({0, 0, 1}, a.z);
+  }
+  if (v.contains("rotation_wxyz")) {
+    const json& q = v.at("rotation_wxyz");
     const char* what = "expected a unit quaternion [w, x, y, z]";
     if (!q.is_array() || q.size() != 4) r.fail(pk + ".rotation_wxyz", what);
     double c[4];
     for (int i = 0; i < 4; ++i) c[i] = r.number(q[std::size_t(i)], pk + ".rotation_wxyz");
     const glm::dquat rotation(c[0], c[1], c[2], c[3]);
     if (std::abs(glm::length(rotation) - 1.0) > 1e-3) r.fail(pk + ".rotation_wxyz", what);
-    p.rotation = glm::normalize(rotation);
+    return glm::normalize(rotation);
   }
+  return fallback;
+}
+
+// "pose": translation, a rotation (read_rotation), scale, model_origin ([x, y, z] or
+// "bottom-centre"), on_floor.
+ObjectPose read_pose(const ManifestReader& r, const json& pose, const std::string& pk) {
+  r.only_keys(pose, pk,
+              {"translation", "rotation_axis", "rotation_deg", "yaw_pitch_roll_deg", "rotation_wxyz", "scale",
+               "model_origin", "on_floor"});
+  ObjectPose p;
+  p.translation = r.position_or(pose, pk, "translation", p.translation);
+  p.rotation = read_rotation(r, pose, pk, p.rotation);
   p.scale = r.scale_or(pose, pk, "scale");
   if (pose.contains("model_origin")) {
     const json& origin = pose.at("model_origin");
@@ -185,9 +194,31 @@ ObjectPose read_pose(const ManifestReader& r, const json& pose, const std::strin
   return p;
 }
 
+// "path": timed key poses, t strictly increasing; each key's translation replaces the
+// pose's, and its rotation turns the posed object (R_key · R_pose).
+std::vector<PathKey> read_path(const ManifestReader& r, const json& v, const std::string& key, const ObjectPose& pose) {
+  const char* what = "expected an array of at least 2 keys {\"t\": s, \"translation\": [x, y, z], rotation}";
+  if (!v.is_array() || v.size() < 2) r.fail(key, what);
+  std::vector<PathKey> keys;
+  for (std::size_t i = 0; i < v.size(); ++i) {
+    const std::string k = key + "[" + std::to_string(i) + "]";
+    if (!v[i].is_object()) r.fail(k, what);
+    r.only_keys(v[i], k, {"t", "translation", "rotation_axis", "rotation_deg", "yaw_pitch_roll_deg", "rotation_wxyz"});
+    if (!v[i].contains("t")) r.fail(k + ".t", "missing (seconds of recording time)");
+    if (!v[i].contains("translation")) r.fail(k + ".translation", "missing");
+    PathKey p{r.number(v[i].at("t"), k + ".t"), pose};
+    if (p.t_s < 0 || p.t_s > 1e6) r.fail(k + ".t", "expected seconds from 0 to 1e6");
+    if (!keys.empty() && p.t_s <= keys.back().t_s) r.fail(k + ".t", "must be later than the key before");
+    p.pose.translation = r.position(v[i].at("translation"), k + ".translation");
+    p.pose.rotation = glm::normalize(read_rotation(r, v[i], k, glm::dquat(1.0, 0.0, 0.0, 0.0)) * pose.rotation);
+    keys.push_back(p);
+  }
+  return keys;
+}
+
 SceneObject read_object(const ManifestReader& r, const json& v, const std::string& key) {
   if (!v.is_object()) r.fail(key, "expected an object");
-  r.only_keys(v, key, {"name", "mesh", "albedo", "pose"});
+  r.only_keys(v, key, {"name", "mesh", "albedo", "pose", "path"});
   SceneObject object;
   object.name = r.string(v, key, "name");
   object.mesh = r.existing_file(v, key, "mesh");
@@ -200,10 +231,8 @@ SceneObject read_object(const ManifestReader& r, const json& v, const std::strin
   }
 
   if (v.contains("pose")) object.pose = read_pose(r, r.object(v, key, "pose"), key + ".pose");
-  const ObjectPose& p = object.pose;
-  object.T_world_model = glm::translate(glm::dmat4(1.0), p.translation) * glm::mat4_cast(p.rotation) *
-                         glm::scale(glm::dmat4(1.0), glm::dvec3(p.scale)) *
-                         glm::translate(glm::dmat4(1.0), -p.model_origin.value_or(glm::dvec3(0.0)));
+  object.T_world_model = pose_matrix(object.pose);
+  if (v.contains("path")) object.path = read_path(r, v.at("path"), key + ".path", object.pose);
   return object;
 }
 
@@ -282,6 +311,12 @@ ShadowRegions read_shadows(const ManifestReader& r, const json& doc) {
 }
 
 }  // namespace
+
+glm::dmat4 pose_matrix(const ObjectPose& p) {
+  return glm::translate(glm::dmat4(1.0), p.translation) * glm::mat4_cast(p.rotation) *
+         glm::scale(glm::dmat4(1.0), glm::dvec3(p.scale)) *
+         glm::translate(glm::dmat4(1.0), -p.model_origin.value_or(glm::dvec3(0.0)));
+}
 
 Scene load_scene(const std::filesystem::path& manifest) {
   const json doc = parse_manifest(manifest);

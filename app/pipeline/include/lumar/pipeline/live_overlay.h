@@ -30,7 +30,12 @@ struct LiveOverlayOptions {
   std::optional<tracking::PoseFilterSettings> filter;
   double max_wait_ms = 40;  // longest a frame waits for the tracker to cover its time
   int max_frames = 0;       // 0: until the source ends, Ctrl-C or the sink says stop
-  OverlaySettings overlay{.window = true, .window_title = "lumar overlay (live)"};
+  OverlaySettings overlay = [] {
+    OverlaySettings s;
+    s.window = true;
+    s.window_title = "lumar overlay (live)";
+    return s;
+  }();
 };
 
 class LiveOverlay {

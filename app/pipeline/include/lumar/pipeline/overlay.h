@@ -31,11 +31,14 @@ struct OverlaySettings {
   // calib/camera_blur.h) unless blur_sigma_px >= 0 gives the blur.
   gl::CompositeFeatures features;
   double blur_sigma_px = -1.0;
+  // Animated objects (the manifest's paths) play in recording time; live, from the first
+  // frame the overlay sees.
+  bool live = false;
 };
 
 struct StageTimes {  // milliseconds, summed over frames
-  double decode = 0, pose = 0, lighting = 0, upload = 0, background = 0, depth = 0, objects = 0, antialiasing = 0,
-         blur = 0, readback = 0, output = 0;
+  double decode = 0, pose = 0, lighting = 0, shadows = 0, upload = 0, background = 0, depth = 0, objects = 0,
+         antialiasing = 0, blur = 0, readback = 0, output = 0;
   int frames = 0;
   double total() const;  // every stage
 };
@@ -60,8 +63,14 @@ class Overlay {
   Overlay(const Overlay&) = delete;
   Overlay& operator=(const Overlay&) = delete;
 
-  // Adapts the lighting (with a pose, on every n-th call) and composites the frame.
+  // Moves the animated objects to where their paths are at the frame's time, adapts the
+  // lighting (with a pose, on every n-th call) and composites the frame.
   OverlayFrame composite(const capture::Frame& frame, const std::optional<Pose>& T_world_camera);
+
+  // Swaps in another scene (objects added or removed, another lighting method): a new
+  // compositor with this one's features, shadow switch and measured camera; the
+  // irradiance volume comes from the cache when its inputs are unchanged.
+  void set_scene(std::shared_ptr<const LoadedScene> scene);
 
   Compositor& compositor() { return *compositor_; }
   const LoadedScene& scene() const { return compositor_->scene(); }
@@ -86,6 +95,9 @@ class Overlay {
   gl::VideoRadiometry radiometry_;
   bool noise_known_ = false, blur_known_ = false, warned_ = false;
   std::int64_t frames_seen_ = 0;
+  bool live_ = false, volume_cache_ = true;
+  std::optional<Nanos> first_frame_time_;
+  void play_paths(Nanos frame_time);
   StageTimes times_;
   int frames_without_pose_ = 0;
 };

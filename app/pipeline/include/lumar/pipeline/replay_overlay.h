@@ -35,6 +35,10 @@ class ReplayOverlay {
   // result and returns false to stop early (e.g. the window was closed).
   void run(int max_frames, const std::function<bool(const OverlayFrame&)>& sink);
 
+  // The camera's pose for a frame of this recording, from the settings' source (nullopt:
+  // the tracker has nothing for it).
+  std::optional<Pose> camera_pose(const capture::Frame& frame) const;
+
   const capture::RecordingReplay& replay() const { return replay_; }
   Overlay& overlay() { return *overlay_; }
   const LoadedScene& scene() const { return overlay_->scene(); }

@@ -36,6 +36,7 @@ class Compositor {
   // Moves object `index` (manifest order): the renderer and the shadow lines follow; the
   // shadows are recomputed in the next composite() only if a pose changed.
   void set_object_pose(std::size_t index, const glm::dmat4& T_world_model);
+  const glm::dmat4& object_pose(std::size_t index) const { return poses_.at(index); }
   // Soft shadows of the objects on the receivers and, with two objects or more, on each
   // other (docs/shadows.md); on by default.
   void set_shadows_enabled(bool on);
@@ -54,8 +55,8 @@ class Compositor {
   // The irradiance volume that shades the objects per pixel (built for the scene's
   // movement box, or loaded from the cache), or nullptr when lighting.method is "sh9".
   const IrradianceVolume* irradiance_volume() const { return volume_.get(); }
-  // A few hundred surface points of the virtual objects, world coordinates, for
-  // checking where they project.
+  // A few hundred surface points of the virtual objects in their current poses, world
+  // coordinates, for checking where they project.
   const std::vector<glm::dvec3>& object_points() const { return object_points_; }
 
  private:
@@ -67,7 +68,10 @@ class Compositor {
   void build_shadows();
   void bake_self_occlusion_once();
   bool self_occlusion_baked_ = false;
-  std::vector<glm::dvec3> object_points_;
+  std::vector<glm::dmat4> poses_;                        // T_world_model per object
+  std::vector<std::vector<glm::dvec3>> sampled_points_;  // per object, model coordinates
+  std::vector<glm::dvec3> object_points_;                // the above, posed
+  void pose_object_points();
   std::shared_ptr<LineShadows> shadows_;  // shared_ptr: LineShadows is incomplete here
   std::shared_ptr<ObjectShadows> object_shadows_;
   bool shadows_enabled_ = true, shadows_uploaded_ = false, object_shadows_uploaded_ = false;

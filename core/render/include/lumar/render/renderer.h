@@ -30,7 +30,9 @@ namespace lumar::gl {
 // Wall time of each stage of render_overlay. Asking for timings makes the stages wait
 // for each other (glFinish between them), so ask only when profiling.
 struct OverlayTimings {
-  double upload_ms = 0, background_ms = 0, depth_ms = 0, objects_ms = 0, antialiasing_ms = 0, blur_ms = 0, readback_ms = 0;
+  double shadows_ms = 0;  // the compositor's: moved objects' shadows traced again (shadow lines)
+  double upload_ms = 0, background_ms = 0, depth_ms = 0, objects_ms = 0, antialiasing_ms = 0, blur_ms = 0,
+         readback_ms = 0;
 };
 
 // How the camera turned light into video, so that rendered pixels look like the

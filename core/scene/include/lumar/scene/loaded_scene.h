@@ -11,15 +11,20 @@
 
 #include "lumar/scene/envmap.h"
 #include "lumar/scene/mesh.h"
+#include "lumar/scene/object_path.h"
 #include "lumar/scene/scene.h"
 
 namespace lumar {
 
 struct LoadedObject {
   std::string name;
-  Mesh model;  // in the file's units
-  glm::dmat4 T_world_model{1.0};
+  Mesh model;                     // in the file's units
+  glm::dmat4 T_world_model{1.0};  // its pose; an animated object's at its path's start
   glm::vec3 albedo{0.8f};
+  ObjectPath path;  // empty: it stands still
+
+  // Where it stands t seconds into the recording.
+  glm::dmat4 pose_at(double t_s) const { return path.empty() ? T_world_model : path.at(t_s); }
 };
 
 struct LoadedScene {

@@ -31,12 +31,25 @@ struct ObjectPose {
   bool on_floor = false;  // moved up or down until its lowest point rests on the proxy below it
 };
 
+// translate(translation) * R * scale * translate(-model_origin); a bottom-centre origin
+// counts as (0, 0, 0) here, and on_floor is not applied (both need the mesh).
+glm::dmat4 pose_matrix(const ObjectPose& pose);
+
+// One key of an animated object's path (manifest key "path", docs/formats.md): where the
+// object stands at t seconds of recording time. Its scale, model origin and on_floor
+// are the object's pose's; its rotation is the key's turn times the pose's rotation.
+struct PathKey {
+  double t_s = 0.0;
+  ObjectPose pose;
+};
+
 struct SceneObject {
   std::string name;
   std::filesystem::path mesh;
   ObjectPose pose;
-  // translate(translation) * R * scale * translate(-model_origin), as given: load_scene_files
-  // (loaded_scene.h) finishes a bottom-centre origin and on_floor, which need the mesh.
+  std::vector<PathKey> path;  // empty: the object stands still at `pose`
+  // pose_matrix(pose): load_scene_files (loaded_scene.h) finishes a bottom-centre origin
+  // and on_floor, which need the mesh.
   glm::dmat4 T_world_model{1.0};
   glm::vec3 albedo{0.8f};
 };
