@@ -13,6 +13,7 @@
 #include "lumar/pipeline/output_files.h"
 #include "lumar/pipeline/progress.h"
 #include "lumar/pipeline/replay_overlay.h"
+#include "lumar/ui/overlay_window.h"
 
 namespace lumar::app {
 
@@ -22,7 +23,8 @@ struct OverlayOptions {
   std::string recording, scene, out, frames_dir, contact_sheet, poses = "tracker", undistort = "same";
   std::string filter = "none", without;
   double blur_sigma = -1.0;
-  bool window = false, no_cache = false, allow_incomplete = false;
+  bool window = false, no_cache = false, allow_incomplete = false, paused = false;
+  std::string save_scene, screenshot;
   int max_frames = 0;
   int adapt_lighting = 0;
   pipeline::LiveOverlayOptions live;  // --source and what only the live path reads
@@ -96,6 +98,7 @@ void run_replay(const OverlayOptions& o) {
   settings.filter = tracking::parse_pose_filter(o.filter);
   settings.allow_incomplete = o.allow_incomplete;
   settings.overlay = overlay_settings(o, o.window);
+  if (o.window) settings.overlay.window_panel_width = ui::kPanelWidth;
   pipeline::ReplayOverlay overlay(o.recording, settings);
   const auto& camera = overlay.compositor().output_camera();
   std::int64_t total = std::int64_t(overlay.replay().reader().frames().size());
@@ -107,13 +110,32 @@ void run_replay(const OverlayOptions& o) {
   pipeline::OverlayOutputs outputs({o.out, o.frames_dir, o.contact_sheet, overlay.replay().reader().video().fps,
                                     cv::Size(camera.width, camera.height), total});
   pipeline::Progress progress("overlay", int(total), "frames", true);  // on a terminal only
-  auto sink = frame_sink(overlay.overlay(), outputs);
   int done = 0;
-  overlay.run(o.max_frames, [&](const pipeline::OverlayFrame& f) {
-    const bool go_on = sink(f);
-    progress.update(++done);
-    return go_on && !stop_requested();
-  });
+  if (o.window) {  // interactive: the window's transport plays, edits and seeks
+    ui::OverlayWindowSettings w;
+    w.save_scene = !o.save_scene.empty()
+                       ? std::filesystem::path(o.save_scene)
+                       : std::filesystem::path(overlay.scene().manifest.manifest.stem().string() + "-edited.json");
+    w.paused = o.paused;
+    if (!o.screenshot.empty()) w.screenshot = o.screenshot;
+    w.max_frames = o.max_frames;
+    ui::run_overlay_window(overlay, w, [&](const pipeline::OverlayFrame& f) {
+      if (done < total) outputs.write(f.index, f.composite);
+      ++done;
+    });
+    if (stop_requested())
+      throw Interrupted(fmt::format("overlay: stopped after {} frames had played; no output written", done));
+    if (done < total && !(o.out.empty() && o.frames_dir.empty() && o.contact_sheet.empty()))
+      throw Interrupted(
+          fmt::format("overlay: the window closed after {} of {} frames had played; no output written", done, total));
+  } else {
+    auto sink = frame_sink(overlay.overlay(), outputs);
+    overlay.run(o.max_frames, [&](const pipeline::OverlayFrame& f) {
+      const bool go_on = sink(f);
+      progress.update(++done);
+      return go_on && !stop_requested();
+    });
+  }
   progress.finish();
   if (stop_requested())
     throw Interrupted(fmt::format("overlay: after {} of {} frames; no output written", done, total));
@@ -154,7 +176,14 @@ void register_overlay(CLI::App& app) {
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   cmd->add_flag("--window", o->window,
-                "Show the result in a window (needs a display); the live path shows one unless it writes files");
+                "Show the result in a window (needs a display): a recording's with panels to play it and to place, "
+                "add and light objects (docs/interactive.md); the live path shows one unless it writes files");
+  cmd->add_option("--save-scene", o->save_scene,
+                  "Window: where File > Save (Ctrl+S) writes the edited scene (default: SCENE-edited.json here)");
+  cmd->add_option("--screenshot", o->screenshot,
+                  "Window: where File > Screenshot (F12; Ctrl+F12 with the panels) writes (default: "
+                  "lumar-screenshot.png here)");
+  cmd->add_flag("--paused", o->paused, "Window: start paused on the first frame");
   cmd->add_flag("--allow-incomplete", o->allow_incomplete,
                 "Replay a recording that was never closed (killed or crashed): its closed frames");
   cmd->add_option("--max-frames", o->max_frames, "Stop after this many frames (0 = all)")->capture_default_str();

@@ -18,7 +18,8 @@ packages=(
   libassimp-dev                      # OBJ, PLY, glTF meshes
   zlib1g-dev
   libgtest-dev libgmock-dev libbenchmark-dev
-  xvfb xauth                         # window tests under xvfb-run
+  libimgui-dev libstb-dev            # Dear ImGui (with its GLFW and OpenGL 3 backends): the window's panels
+  xvfb xauth xdotool                 # window tests under xvfb-run, driven by xdotool
   python3                            # JSON checks in the command-line tests
 )
 case "${1:-}" in

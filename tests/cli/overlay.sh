@@ -73,8 +73,8 @@ case_window_without_display_fails_cleanly() {
 }
 
 case_regress_sample() {
-  "$LUMAR" regress "$REC" | tee "$TMP/log" || fail "regression failed"
-  grep -q "^PASS" "$TMP/log" || fail "no PASS line"
+  "$LUMAR" regress "$REC" "$SRC/recordings/walk" | tee "$TMP/log" || fail "regression failed"
+  [ "$(grep -c "^PASS" "$TMP/log")" -eq 2 ] || fail "expected two PASS lines (orbit, walk)"
 }
 
 # A copy of the sample recording at the same depth, so its relative scene path still resolves.

@@ -41,7 +41,9 @@ Overlay::Overlay(std::shared_ptr<const LoadedScene> scene, const CameraIntrinsic
       throw RuntimeError(
           "overlay: no display to open a window on (DISPLAY is not set); to run headless, leave out --window and "
           "give --out or --frames-dir (the live path too), or run under xvfb-run");
-    auto w = std::make_unique<gl::WindowContext>(camera.width, camera.height, settings.window_title);
+    const int panel = std::max(0, settings.window_panel_width);
+    const cv::Size size(camera.width + panel, panel > 0 ? std::max(camera.height, 720) : camera.height);
+    auto w = std::make_unique<gl::WindowContext>(size.width, size.height, settings.window_title);
     window_ = w.get();
     context_ = std::move(w);
   } else {
@@ -141,7 +143,8 @@ OverlayFrame Overlay::composite(const capture::Frame& frame, const std::optional
   }
   // The map's light scaled as the room changed: the objects' radiance scales with it.
   gl::OverlayTimings gt;
-  out.composite = compositor_->composite(frame.image, T_world_camera, exposure_ * out.lighting_scale, &gt);
+  out.composite =
+      compositor_->composite(frame.image, T_world_camera, exposure_ * exposure_scale_ * out.lighting_scale, &gt);
   times_.shadows += gt.shadows_ms;
   times_.upload += gt.upload_ms;
   times_.background += gt.background_ms;

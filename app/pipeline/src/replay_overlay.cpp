@@ -28,6 +28,12 @@ ReplayOverlay::ReplayOverlay(const std::filesystem::path& recording, const Repla
                                        calib::calibrated_response(session.radiometry, recording), settings.overlay);
 }
 
+void ReplayOverlay::set_pose_source(PoseSource source) {
+  if (source == PoseSource::Truth && replay_.reader().truth().empty())
+    throw InputError("this recording has no ground truth (truth.csv); use the tracker's poses");
+  pose_source_ = source;
+}
+
 std::optional<Pose> ReplayOverlay::camera_pose(const capture::Frame& frame) const {
   return pose_source_ == PoseSource::Truth ? replay_.true_camera_pose(frame.index)
                                            : replay_.tracked_camera_pose(frame.time);

@@ -111,19 +111,21 @@ void Compositor::set_object_pose(std::size_t index, const glm::dmat4& T_world_mo
   if (object_shadows_) object_shadows_->set_object_pose(int(index), T_world_model);
 }
 
-void Compositor::set_shadows_enabled(bool on) {
-  if (on == shadows_enabled_) return;
-  shadows_enabled_ = on;
-  shadows_uploaded_ = object_shadows_uploaded_ = false;
-  if (shadows_ && !on) {
-    const std::vector<glm::vec3> ones(shadows_->attenuation().size(), glm::vec3(1.0f));
-    renderer_->set_receiver_attenuation(ones);
+void Compositor::set_shadows_enabled(bool on, bool on_each_other) {
+  if (on != shadows_enabled_) {
+    shadows_enabled_ = on;
+    shadows_uploaded_ = false;
+    if (shadows_ && !on)
+      renderer_->set_receiver_attenuation(std::vector<glm::vec3>(shadows_->attenuation().size(), glm::vec3(1.0f)));
   }
-  if (object_shadows_ && !on)
-    for (std::size_t i = 0; i < object_shadows_->object_count(); ++i) {
-      const std::vector<glm::vec3> ones(object_shadows_->vertex_attenuation(int(i)).size(), glm::vec3(1.0f));
-      renderer_->set_object_light_attenuation(int(i), ones);
-    }
+  if (on_each_other != object_shadows_enabled_) {
+    object_shadows_enabled_ = on_each_other;
+    object_shadows_uploaded_ = false;
+    if (object_shadows_ && !on_each_other)
+      for (std::size_t i = 0; i < object_shadows_->object_count(); ++i)
+        renderer_->set_object_light_attenuation(
+            int(i), std::vector<glm::vec3>(object_shadows_->vertex_attenuation(int(i)).size(), glm::vec3(1.0f)));
+  }
 }
 
 cv::Mat Compositor::composite(const cv::Mat& video_bgr8, const std::optional<Pose>& T_world_camera, double exposure,
@@ -133,7 +135,7 @@ cv::Mat Compositor::composite(const cv::Mat& video_bgr8, const std::optional<Pos
     renderer_->set_receiver_attenuation(shadows_->attenuation());
     shadows_uploaded_ = true;
   }
-  if (object_shadows_ && shadows_enabled_ && (object_shadows_->update() || !object_shadows_uploaded_)) {
+  if (object_shadows_ && object_shadows_enabled_ && (object_shadows_->update() || !object_shadows_uploaded_)) {
     for (std::size_t i = 0; i < object_shadows_->object_count(); ++i)
       renderer_->set_object_light_attenuation(int(i), object_shadows_->vertex_attenuation(int(i)));
     object_shadows_uploaded_ = true;

@@ -64,6 +64,8 @@ void save_scene(const Scene& scene, const std::filesystem::path& out) {
     objects.push_back(entry);
   }
   doc["objects"] = objects;
+  if (doc.contains("lighting") || scene.lighting.method != LightingSettings{}.method)
+    doc["lighting"]["method"] = scene.lighting.method;
   write_file_atomically(out, doc.dump(2) + "\n");
 }
 

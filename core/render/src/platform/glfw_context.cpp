@@ -86,7 +86,11 @@ bool WindowContext::should_close() const { return glfwWindowShouldClose(impl_->w
 
 void WindowContext::poll_events() { glfwPollEvents(); }
 
-void WindowContext::present(const cv::Mat& bgr8) {
+void WindowContext::wait_events(double seconds) { glfwWaitEventsTimeout(seconds); }
+
+GLFWwindow* WindowContext::window_handle() { return impl_->window; }
+
+void WindowContext::draw_image(const cv::Mat& bgr8, bool in_corner) {
   if (bgr8.type() != CV_8UC3 || bgr8.empty())
     throw InputError("OpenGL window: present needs a non-empty BGR8 (CV_8UC3) image");
   make_current();
@@ -107,12 +111,44 @@ void WindowContext::present(const cv::Mat& bgr8) {
   glDrawBuffer(GL_BACK);
   glDisable(GL_SCISSOR_TEST);
   glDisable(GL_FRAMEBUFFER_SRGB);
+  if (in_corner) {
+    glViewport(0, 0, fb_width, fb_height);
+    glClearColor(0.12f, 0.12f, 0.13f, 1.0f);
+    glClear(GL_COLOR_BUFFER_BIT);
+  }
   // Texel row 0 (the top row) goes to the window's top edge: flip the destination.
-  const bool same_size = fb_width == bgr8.cols && fb_height == bgr8.rows;
-  glBlitNamedFramebuffer(w.image_fbo.get(), 0, 0, 0, bgr8.cols, bgr8.rows, 0, fb_height, fb_width, 0,
-                         GL_COLOR_BUFFER_BIT, same_size ? GL_NEAREST : GL_LINEAR);
+  const int x1 = in_corner ? bgr8.cols : fb_width, y0 = in_corner ? fb_height - bgr8.rows : 0;
+  const bool same_size = x1 == bgr8.cols && fb_height - y0 == bgr8.rows;
+  glBlitNamedFramebuffer(w.image_fbo.get(), 0, 0, 0, bgr8.cols, bgr8.rows, 0, fb_height, x1, y0, GL_COLOR_BUFFER_BIT,
+                         same_size ? GL_NEAREST : GL_LINEAR);
   check_gl_errors("WindowContext::present");
-  glfwSwapBuffers(w.window);
+}
+
+void WindowContext::present(const cv::Mat& bgr8) {
+  draw_image(bgr8, false);
+  glfwSwapBuffers(impl_->window);
+}
+
+void WindowContext::present_in_corner(const cv::Mat& bgr8, const std::function<void()>& draw_over) {
+  draw_image(bgr8, true);
+  if (draw_over) draw_over();
+  check_gl_errors("WindowContext::present_in_corner");
+  glfwSwapBuffers(impl_->window);
+}
+
+cv::Mat WindowContext::read_back_buffer() {
+  make_current();
+  int width = 0, height = 0;
+  glfwGetFramebufferSize(impl_->window, &width, &height);
+  cv::Mat image(height, width, CV_8UC3);
+  glBindFramebuffer(GL_READ_FRAMEBUFFER, 0);
+  glReadBuffer(GL_BACK);
+  glPixelStorei(GL_PACK_ALIGNMENT, 1);
+  glPixelStorei(GL_PACK_ROW_LENGTH, 0);
+  glReadPixels(0, 0, width, height, GL_BGR, GL_UNSIGNED_BYTE, image.data);
+  check_gl_errors("WindowContext::read_back_buffer");
+  cv::flip(image, image, 0);  // GL's rows start at the bottom
+  return image;
 }
 
 cv::Mat WindowContext::read_front_buffer() {

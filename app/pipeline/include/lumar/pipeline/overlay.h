@@ -25,6 +25,9 @@ struct OverlaySettings {
   int adapt_lighting_every = 0;
   bool window = false;  // a GLFW window to draw into; else a headless EGL context
   std::string window_title = "lumar overlay";
+  // > 0: room for panels right of the video (the interactive window), which is then at
+  // least 720 pixels tall; else the window is the camera's size.
+  int window_panel_width = 0;
   bool volume_cache = true;  // the irradiance volume from / into the disk cache
   // What makes the objects look like the camera's pixels; the camera's noise and blur
   // are estimated from the first frames of the video (calib/sensor_noise.h,
@@ -71,6 +74,9 @@ class Overlay {
   // compositor with this one's features, shadow switch and measured camera; the
   // irradiance volume comes from the cache when its inputs are unchanged.
   void set_scene(std::shared_ptr<const LoadedScene> scene);
+  // Scales the objects' brightness against the video's (1: the session's exposure).
+  void set_exposure_scale(double scale) { exposure_scale_ = scale; }
+  double exposure_scale() const { return exposure_scale_; }
 
   Compositor& compositor() { return *compositor_; }
   const LoadedScene& scene() const { return compositor_->scene(); }
@@ -86,7 +92,7 @@ class Overlay {
   std::unique_ptr<gl::Context> context_;
   gl::WindowContext* window_ = nullptr;
   std::unique_ptr<Compositor> compositor_;
-  double exposure_ = 1.0;
+  double exposure_ = 1.0, exposure_scale_ = 1.0;
   std::optional<LiveLighting> live_lighting_;
   // The camera's noise and blur, measured from the video until they are known.
   void measure_camera(const cv::Mat& video);

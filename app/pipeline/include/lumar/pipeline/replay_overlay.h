@@ -38,6 +38,9 @@ class ReplayOverlay {
   // The camera's pose for a frame of this recording, from the settings' source (nullopt:
   // the tracker has nothing for it).
   std::optional<Pose> camera_pose(const capture::Frame& frame) const;
+  PoseSource pose_source() const { return pose_source_; }
+  // Truth: InputError when the recording has none.
+  void set_pose_source(PoseSource source);
 
   const capture::RecordingReplay& replay() const { return replay_; }
   Overlay& overlay() { return *overlay_; }

@@ -38,8 +38,11 @@ class Compositor {
   void set_object_pose(std::size_t index, const glm::dmat4& T_world_model);
   const glm::dmat4& object_pose(std::size_t index) const { return poses_.at(index); }
   // Soft shadows of the objects on the receivers and, with two objects or more, on each
-  // other (docs/shadows.md); on by default.
-  void set_shadows_enabled(bool on);
+  // other (docs/shadows.md); on by default. `on_each_other`: the latter alone.
+  void set_shadows_enabled(bool on, bool on_each_other);
+  void set_shadows_enabled(bool on) { set_shadows_enabled(on, on); }
+  bool shadows_enabled() const { return shadows_enabled_; }
+  bool object_shadows_enabled() const { return object_shadows_enabled_; }
   // Antialiasing, self-occlusion, noise and blur (gl::CompositeFeatures); all on by
   // default. The objects' self-occlusion is baked the first time it is on.
   void set_features(const gl::CompositeFeatures& features);
@@ -74,7 +77,8 @@ class Compositor {
   void pose_object_points();
   std::shared_ptr<LineShadows> shadows_;  // shared_ptr: LineShadows is incomplete here
   std::shared_ptr<ObjectShadows> object_shadows_;
-  bool shadows_enabled_ = true, shadows_uploaded_ = false, object_shadows_uploaded_ = false;
+  bool shadows_enabled_ = true, object_shadows_enabled_ = true, shadows_uploaded_ = false,
+       object_shadows_uploaded_ = false;
 };
 
 }  // namespace lumar

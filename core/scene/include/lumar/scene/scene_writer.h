@@ -1,7 +1,7 @@
 #pragma once
-// Saving a scene someone edited (objects placed, added, removed, recoloured): the
-// manifest it was read from, with its objects rewritten and everything else kept as it
-// was (room, map, lighting, shadows, and each object's keys the editor does not change,
+// Saving a scene someone edited (objects placed, added, removed, recoloured, another
+// lighting method): the manifest it was read from, with its objects and lighting method
+// rewritten and everything else kept as it was (room, map, lighting, shadows, and each object's keys the editor does not change,
 // such as an animated object's path). Relative paths are rewritten against the new
 // manifest's folder, so the copy may live anywhere.
 #include <filesystem>

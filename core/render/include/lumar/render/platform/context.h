@@ -3,9 +3,12 @@
 // a surfaceless EGL context (offline rendering, tests, no X server) or a GLFW window
 // (the interactive viewer). GL objects belong to the context that was current when
 // they were made; destroy them while it is current again.
+#include <functional>
 #include <memory>
 #include <opencv2/core.hpp>
 #include <string>
+
+struct GLFWwindow;
 
 namespace lumar::gl {
 
@@ -35,9 +38,20 @@ class WindowContext : public Context {
   std::string renderer_name() const override;
   bool should_close() const;
   void poll_events();
+  // Waits up to `seconds` for an event (input, a resize), then handles what came.
+  void wait_events(double seconds);
   // Draws a BGR8 image (top row first) over the whole window, scaled if the sizes
   // differ, and swaps buffers.
   void present(const cv::Mat& bgr8);
+  // Draws a BGR8 image at its own size in the window's top-left corner, clears the rest,
+  // calls `draw_over` (a user interface's draw calls, in the window's framebuffer) and
+  // swaps buffers. Window pixel (x, y) from the top-left shows image pixel (x, y).
+  void present_in_corner(const cv::Mat& bgr8, const std::function<void()>& draw_over);
+  // What has been drawn into the back buffer so far (call it inside present_in_corner's
+  // draw_over, after the user interface drew): the whole window, BGR8, top row first.
+  cv::Mat read_back_buffer();
+  // The GLFW window, for a user interface library's backend.
+  GLFWwindow* glfw_window() { return window_handle(); }
   // What the window shows after the last present(), as the X server has it (for tests),
   // BGR8, top row first.
   cv::Mat read_front_buffer();
@@ -45,6 +59,8 @@ class WindowContext : public Context {
  private:
   struct Impl;
   std::unique_ptr<Impl> impl_;
+  GLFWwindow* window_handle();
+  void draw_image(const cv::Mat& bgr8, bool in_corner);
 };
 
 }  // namespace lumar::gl
