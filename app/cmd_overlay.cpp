@@ -117,6 +117,7 @@ void run_replay(const OverlayOptions& o) {
                        ? std::filesystem::path(o.save_scene)
                        : std::filesystem::path(overlay.scene().manifest.manifest.stem().string() + "-edited.json");
     w.paused = o.paused;
+    w.pose_filter = o.filter != "none";
     if (!o.screenshot.empty()) w.screenshot = o.screenshot;
     w.max_frames = o.max_frames;
     ui::run_overlay_window(overlay, w, [&](const pipeline::OverlayFrame& f) {

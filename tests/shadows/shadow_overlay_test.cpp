@@ -12,6 +12,7 @@
 #include <sstream>
 
 #include "lumar/base/color.h"
+#include "lumar/base/error.h"
 #include "lumar/lighting/shadows/object_shadows.h"
 #include "lumar/lighting/shadows/shadow_occlusion.h"
 #include "lumar/render/compositor.h"
@@ -242,6 +243,47 @@ TEST(ShadowOverlay, ObjectsShadowEachOther) {
   EXPECT_LT(median, 0.01);
   EXPECT_LT(p95, 0.03);
   EXPECT_LT(darkest, 0.85);  // the shadow is really there
+}
+
+// The quality knobs rebuild the lines (fewer patches and lines per patch: fewer lines) and
+// keep every object where it was moved: back at the defaults, the moved object's shadow
+// is that of a compositor built with the object standing there.
+TEST(ShadowOverlay, QualityKnobsRebuildTheLinesAndKeepTheObjectsWhereTheyAre) {
+  context();
+  auto scene =
+      std::make_shared<const LoadedScene>(load_scene_files(test::source_dir() / "data/scenes/room/scene.json"));
+  CameraIntrinsics camera;
+  Pose pose;
+  recording_view(15, camera, pose);
+  Compositor compositor(scene, camera, cv::Mat(), cv::Mat());
+  ASSERT_NE(compositor.shadows(), nullptr);
+  const std::size_t default_lines = compositor.shadows()->lines().lines.size();
+  const glm::dmat4 moved =
+      glm::translate(glm::dmat4(1.0), glm::dvec3(0.12, 0.0, 0.05)) * scene->objects[0].T_world_model;
+  compositor.set_object_pose(0, moved);
+  compositor.set_shadow_quality({.emitter_patches = 16, .lines_per_patch = 2});
+  EXPECT_LE(compositor.shadows()->lines().patch_count, 16u);
+  EXPECT_LT(compositor.shadows()->lines().lines.size(), default_lines / 4);
+  EXPECT_THROW(compositor.set_shadow_quality({.emitter_patches = 0}), InputError);
+  compositor.set_shadow_quality({});
+  EXPECT_EQ(compositor.shadows()->lines().lines.size(), default_lines);
+
+  LoadedScene there = *scene;
+  there.objects[0].T_world_model = moved;
+  Compositor fresh(std::make_shared<const LoadedScene>(there), camera, cv::Mat(), cv::Mat());
+  const cv::Mat video(camera.height, camera.width, CV_8UC3, cv::Scalar(128, 128, 128));
+  compositor.composite(video, pose, 0.66);
+  fresh.composite(video, pose, 0.66);
+  const auto& a = compositor.shadows()->attenuation();
+  const auto& b = fresh.shadows()->attenuation();
+  ASSERT_EQ(a.size(), b.size());
+  float worst = 0, least = 1;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    worst = std::max(worst, glm::length(a[i] - b[i]));
+    least = std::min(least, a[i].y);
+  }
+  EXPECT_LT(worst, 1e-6f);
+  EXPECT_LT(least, 0.9f);  // there is a shadow to compare
 }
 
 }  // namespace

@@ -34,7 +34,11 @@ gl::VideoRadiometry renderer_radiometry(const capture::Radiometry& radiometry, c
 Overlay::Overlay(std::shared_ptr<const LoadedScene> scene, const CameraIntrinsics& camera,
                  const capture::Radiometry& radiometry, const std::optional<calib::CameraResponse>& response,
                  const OverlaySettings& settings)
-    : exposure_(radiometry.exposure), live_(settings.live), volume_cache_(settings.volume_cache) {
+    : exposure_(radiometry.exposure),
+      camera_(camera),
+      session_radiometry_(radiometry),
+      live_(settings.live),
+      volume_cache_(settings.volume_cache) {
   if (settings.window) {
     const char* display = std::getenv("DISPLAY");
     if (!display || !*display)
@@ -61,8 +65,7 @@ Overlay::Overlay(std::shared_ptr<const LoadedScene> scene, const CameraIntrinsic
   if (settings.blur_sigma_px >= 0) radiometry_.blur_sigma_px = settings.blur_sigma_px, blur_known_ = true;
   compositor_->set_features(settings.features);
   compositor_->renderer().set_video_radiometry(radiometry_);
-  if (settings.adapt_lighting_every > 0)
-    live_lighting_.emplace(camera, maps, response_, radiometry, settings.adapt_lighting_every);
+  set_adapt_lighting_every(settings.adapt_lighting_every);
 }
 
 // The first frame, and every kRetry-th until both are known (a camera may start on a
@@ -100,6 +103,13 @@ void Overlay::measure_camera(const cv::Mat& video) {
     warned_ = true;
   }
   compositor_->renderer().set_video_radiometry(radiometry_);
+}
+
+void Overlay::set_adapt_lighting_every(int every_n_frames) {
+  if (every_n_frames <= 0)
+    live_lighting_.reset();
+  else
+    live_lighting_.emplace(camera_, maps_, response_, session_radiometry_, every_n_frames);
 }
 
 void Overlay::set_scene(std::shared_ptr<const LoadedScene> scene) {

@@ -13,7 +13,7 @@ double ms_since(std::chrono::steady_clock::time_point t0) {
 }  // namespace
 
 ReplayOverlay::ReplayOverlay(const std::filesystem::path& recording, const ReplayOverlaySettings& settings)
-    : replay_(recording, settings.filter), pose_source_(settings.poses) {
+    : recording_(recording), replay_(recording, settings.filter), pose_source_(settings.poses) {
   if (!replay_.reader().complete() && !settings.allow_incomplete)
     throw InputError(recording.string() + ": incomplete recording (\"complete\": false; its writer was killed, " +
                      "crashed or ran out of disk); its " + std::to_string(replay_.reader().frames().size()) +
@@ -26,6 +26,10 @@ ReplayOverlay::ReplayOverlay(const std::filesystem::path& recording, const Repla
   const capture::Session& session = replay_.session();
   overlay_ = std::make_unique<Overlay>(std::move(scene), session.camera, session.radiometry,
                                        calib::calibrated_response(session.radiometry, recording), settings.overlay);
+}
+
+void ReplayOverlay::set_pose_filter(const std::optional<tracking::PoseFilterSettings>& filter) {
+  replay_ = capture::RecordingReplay(recording_, filter);
 }
 
 void ReplayOverlay::set_pose_source(PoseSource source) {

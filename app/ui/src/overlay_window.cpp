@@ -17,7 +17,10 @@
 #include "lumar/base/error.h"
 #include "lumar/base/stop_signal.h"
 #include "lumar/calib/image_file.h"
+#include "lumar/lighting/shadows/shadow_occlusion.h"
 #include "lumar/scene/scene.h"
+#include "lumar/tracking/one_euro_filter.h"
+#include "lumar/ui/debug_views.h"
 #include "scene_editor.h"
 
 namespace lumar::ui {
@@ -74,6 +77,7 @@ class OverlayWindow {
     save_path_ = settings.save_scene.string();
     screenshot_path_ = settings.screenshot.string();
     features_ = overlay_.compositor().renderer().features();
+    filtered_ = settings.pose_filter;
     glfwSetWindowUserPointer(window_.glfw_window(), this);
     if (!seek(0)) throw InputError("overlay: the recording's first frame cannot be read");
   }
@@ -97,7 +101,9 @@ class OverlayWindow {
       advance();
       if (dirty_) composite();
       ImGui::Render();
-      window_.present_in_corner(image_, [&] {
+      const cv::Mat shown =
+          debug_.any() && pose_ ? draw_debug_views(image_, overlay_.compositor(), *pose_, debug_) : image_;
+      window_.present_in_corner(shown, [&] {
         ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
         if (window_shot_) {
           window_shot_ = false;
@@ -405,6 +411,7 @@ class OverlayWindow {
     transport_panel();
     objects_panel();
     lighting_panel();
+    quality_panel();
     stats_panel();
     file_panel();
     ImGui::End();
@@ -492,6 +499,38 @@ class OverlayWindow {
       });
   }
 
+  // The knobs that trade speed for accuracy, the pose filter, and what to draw over the video.
+  void quality_panel() {
+    if (!ImGui::CollapsingHeader("Quality and debug views")) return;
+    Compositor& compositor = overlay_.compositor();
+    ShadowQuality q = compositor.shadow_quality();
+    ImGui::SliderInt("emitter patches", &q.emitter_patches, 4, 256);
+    const bool patches_done = ImGui::IsItemDeactivatedAfterEdit();
+    ImGui::SliderInt("lines per patch", &q.lines_per_patch, 1, 32);
+    if (patches_done || ImGui::IsItemDeactivatedAfterEdit())
+      attempt("shadow quality", [&] {
+        compositor.set_shadow_quality(q);
+        dirty_ = true;
+      });
+    if (const LineShadows* lines = compositor.shadows())
+      ImGui::Text("%zu radiosity lines, %u emitter patches", lines->lines().lines.size(), lines->lines().patch_count);
+    bool adapt = overlay_.live_lighting() != nullptr;
+    if (ImGui::Checkbox("follow the room's lighting (every 10 frames)", &adapt))
+      overlay_.set_adapt_lighting_every(adapt ? 10 : 0), dirty_ = true;
+    if (ImGui::Checkbox("One Euro filter on the tracker's poses", &filtered_))
+      attempt("pose filter", [&] {
+        replay_.set_pose_filter(filtered_ ? tracking::parse_pose_filter("one-euro") : std::nullopt);
+        frames_.reset();  // the frames came from the replay just replaced
+        seek(current_);
+      });
+    ImGui::Checkbox("proxy wireframe", &debug_.proxy_wireframe);
+    ImGui::SameLine();
+    ImGui::Checkbox("receivers", &debug_.receivers);
+    ImGui::Checkbox("emitter samples", &debug_.emitters);
+    ImGui::SameLine();
+    ImGui::Checkbox("irradiance probes", &debug_.probes);
+  }
+
   void stats_panel() {
     if (!ImGui::CollapsingHeader("Stats", ImGuiTreeNodeFlags_DefaultOpen) || stats_.empty()) return;
     std::vector<float> totals;
@@ -555,7 +594,8 @@ class OverlayWindow {
   std::array<char, 1024> add_path_{};
 
   // lighting
-  bool shadows_ = true, object_shadows_ = true;
+  bool shadows_ = true, object_shadows_ = true, filtered_ = false;
+  DebugViews debug_;
   gl::CompositeFeatures features_;
 
   std::vector<KeyPress> keys_;

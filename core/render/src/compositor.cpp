@@ -4,6 +4,7 @@
 
 #include <chrono>
 
+#include "lumar/base/error.h"
 #include "lumar/lighting/irradiance_scene.h"
 #include "lumar/lighting/irradiance_volume.h"
 #include "lumar/lighting/self_occlusion.h"
@@ -86,20 +87,34 @@ void Compositor::build_shadows() {
       around.positions.insert(around.positions.end(), posed.positions.begin(), posed.positions.end());
       around.normals.insert(around.normals.end(), posed.normals.begin(), posed.normals.end());
     }
-  const Emitters emitters = shadow_scene.emitters(around.positions, around.normals);
+  EmitterOptions options;
+  options.max_patches = shadow_quality_.emitter_patches;
+  options.samples_per_patch = shadow_quality_.lines_per_patch;
+  const Emitters emitters = shadow_scene.emitters(around.positions, around.normals, options);
   if (on_receivers) {
     shadows_ = std::make_shared<LineShadows>(
         build_shadow_lines(receivers.positions, receivers.normals, emitters, shadow_scene.proxy()));
-    for (const auto& o : objects) shadows_->add_object(o.model, o.T_world_model);
+    for (std::size_t i = 0; i < objects.size(); ++i) shadows_->add_object(objects[i].model, poses_[i]);
     renderer_->set_receivers(receivers);
     spdlog::debug("shadows: {} receivers, {} emitter patches, {} lines", receivers.positions.size(),
                   emitters.patches.size(), shadows_->lines().lines.size());
   }
   if (objects.size() >= 2) {
     object_shadows_ = std::make_shared<ObjectShadows>(emitters);
-    for (const auto& o : objects) object_shadows_->add_object(o.model, o.T_world_model);
+    for (std::size_t i = 0; i < objects.size(); ++i) object_shadows_->add_object(objects[i].model, poses_[i]);
     spdlog::debug("objects shadow each other: {} objects, {} emitter samples", objects.size(), emitters.samples.size());
   }
+}
+
+void Compositor::set_shadow_quality(const ShadowQuality& quality) {
+  if (quality == shadow_quality_) return;
+  if (quality.emitter_patches < 1 || quality.lines_per_patch < 1)
+    throw InputError("shadow quality: emitter patches and lines per patch must be at least 1");
+  shadow_quality_ = quality;
+  shadows_.reset();
+  object_shadows_.reset();
+  build_shadows();
+  shadows_uploaded_ = object_shadows_uploaded_ = false;
 }
 
 void Compositor::set_object_pose(std::size_t index, const glm::dmat4& T_world_model) {

@@ -74,6 +74,9 @@ class Overlay {
   // compositor with this one's features, shadow switch and measured camera; the
   // irradiance volume comes from the cache when its inputs are unchanged.
   void set_scene(std::shared_ptr<const LoadedScene> scene);
+  // > 0: every that many frames, compare the video with the map and follow the room's
+  // lighting (OverlaySettings::adapt_lighting_every); 0: off, back to the map's light.
+  void set_adapt_lighting_every(int every_n_frames);
   // Scales the objects' brightness against the video's (1: the session's exposure).
   void set_exposure_scale(double scale) { exposure_scale_ = scale; }
   double exposure_scale() const { return exposure_scale_; }
@@ -93,6 +96,8 @@ class Overlay {
   gl::WindowContext* window_ = nullptr;
   std::unique_ptr<Compositor> compositor_;
   double exposure_ = 1.0, exposure_scale_ = 1.0;
+  CameraIntrinsics camera_;  // the video's, distorted
+  capture::Radiometry session_radiometry_;
   std::optional<LiveLighting> live_lighting_;
   // The camera's noise and blur, measured from the video until they are known.
   void measure_camera(const cv::Mat& video);

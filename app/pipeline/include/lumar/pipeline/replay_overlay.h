@@ -42,6 +42,10 @@ class ReplayOverlay {
   // Truth: InputError when the recording has none.
   void set_pose_source(PoseSource source);
 
+  // Decodes the tracker stream again through this filter (nullopt: none). Frame sources
+  // opened from replay() before are stale afterwards: open them again.
+  void set_pose_filter(const std::optional<tracking::PoseFilterSettings>& filter);
+
   const capture::RecordingReplay& replay() const { return replay_; }
   Overlay& overlay() { return *overlay_; }
   const LoadedScene& scene() const { return overlay_->scene(); }
@@ -52,6 +56,7 @@ class ReplayOverlay {
   const LiveLighting* live_lighting() const { return overlay_->live_lighting(); }
 
  private:
+  std::filesystem::path recording_;
   capture::RecordingReplay replay_;
   PoseSource pose_source_;
   std::unique_ptr<Overlay> overlay_;

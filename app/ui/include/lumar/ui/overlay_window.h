@@ -28,7 +28,8 @@ struct OverlayWindowSettings {
   std::filesystem::path screenshot = "lumar-screenshot.png";  // File > Screenshot and F12
   bool paused = false;                                        // start paused on the first frame
   bool loop = true;                                           // play again from the start at the end
-  int max_frames = 0;  // > 0: close after playing this many frames (scripted runs)
+  bool pose_filter = false;  // the replay's tracker poses are filtered (the panel's switch)
+  int max_frames = 0;        // > 0: close after playing this many frames (scripted runs)
 };
 
 // Runs `replay` (made with a window with pipeline::OverlaySettings::window_panel_width =

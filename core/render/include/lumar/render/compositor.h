@@ -18,6 +18,15 @@ class LineShadows;
 class ObjectShadows;
 class IrradianceVolume;
 
+// The shadows' quality knobs (docs/shadows.md): how many emitter patches the map is split
+// into, and how many sample points (line ends) each patch has, so lines per receiver and
+// patch.
+struct ShadowQuality {
+  int emitter_patches = 64;
+  int lines_per_patch = 8;
+  bool operator==(const ShadowQuality&) const = default;
+};
+
 class Compositor {
  public:
   // `output_camera`: the undistorted camera the renderer draws with. `map_x`, `map_y`:
@@ -43,6 +52,10 @@ class Compositor {
   void set_shadows_enabled(bool on) { set_shadows_enabled(on, on); }
   bool shadows_enabled() const { return shadows_enabled_; }
   bool object_shadows_enabled() const { return object_shadows_enabled_; }
+  // Rebuilds the shadow lines and the objects' shadows on each other with these knobs;
+  // the objects keep their current poses.
+  void set_shadow_quality(const ShadowQuality& quality);
+  const ShadowQuality& shadow_quality() const { return shadow_quality_; }
   // Antialiasing, self-occlusion, noise and blur (gl::CompositeFeatures); all on by
   // default. The objects' self-occlusion is baked the first time it is on.
   void set_features(const gl::CompositeFeatures& features);
@@ -77,6 +90,7 @@ class Compositor {
   void pose_object_points();
   std::shared_ptr<LineShadows> shadows_;  // shared_ptr: LineShadows is incomplete here
   std::shared_ptr<ObjectShadows> object_shadows_;
+  ShadowQuality shadow_quality_;
   bool shadows_enabled_ = true, object_shadows_enabled_ = true, shadows_uploaded_ = false,
        object_shadows_uploaded_ = false;
 };
