@@ -42,17 +42,24 @@ pipeline::OverlaySettings overlay_settings(const OverlayOptions& o, bool window)
   return s;
 }
 
-// Writes every frame to the outputs and shows it in the window, if there is one.
-auto frame_sink(pipeline::Overlay& overlay, pipeline::OverlayOutputs& outputs) {
+// Writes every frame to the outputs (the headless paths; a window has its own loop).
+auto frame_sink(pipeline::OverlayOutputs& outputs) {
   return [&](const pipeline::OverlayFrame& f) {
     outputs.write(f.index, f.composite);
-    if (auto* w = overlay.window()) {
-      w->present(f.composite);
-      w->poll_events();
-      return !w->should_close();
-    }
     return true;
   };
+}
+
+ui::OverlayWindowSettings window_settings(const OverlayOptions& o, const pipeline::Overlay& overlay) {
+  ui::OverlayWindowSettings w;
+  w.save_scene = !o.save_scene.empty()
+                     ? std::filesystem::path(o.save_scene)
+                     : std::filesystem::path(overlay.scene().manifest.manifest.stem().string() + "-edited.json");
+  if (!o.screenshot.empty()) w.screenshot = o.screenshot;
+  w.paused = o.paused;
+  w.pose_filter = o.filter != "none";
+  w.max_frames = o.max_frames;
+  return w;
 }
 
 void report(const pipeline::Overlay& overlay) {
@@ -76,10 +83,16 @@ void run_live(OverlayOptions& o) {
   const bool window = o.window || (o.out.empty() && o.frames_dir.empty());
   live.overlay = overlay_settings(o, window);
   live.overlay.window_title = "lumar overlay (live)";
+  if (window) live.overlay.window_panel_width = ui::kPanelWidth;
   pipeline::LiveOverlay overlay(live);
   const auto& camera = overlay.overlay().compositor().output_camera();
   pipeline::OverlayOutputs outputs({o.out, o.frames_dir, "", overlay.fps(), cv::Size(camera.width, camera.height)});
-  overlay.run(frame_sink(overlay.overlay(), outputs));
+  if (window) {  // the panels, and the camera's and tracker's status
+    ui::run_live_overlay_window(overlay, window_settings(o, overlay.overlay()),
+                                [&](const pipeline::OverlayFrame& f) { outputs.write(f.index, f.composite); });
+  } else {
+    overlay.run(frame_sink(outputs));
+  }
   outputs.commit();
   report(overlay.overlay());
 }
@@ -112,15 +125,7 @@ void run_replay(const OverlayOptions& o) {
   pipeline::Progress progress("overlay", int(total), "frames", true);  // on a terminal only
   int done = 0;
   if (o.window) {  // interactive: the window's transport plays, edits and seeks
-    ui::OverlayWindowSettings w;
-    w.save_scene = !o.save_scene.empty()
-                       ? std::filesystem::path(o.save_scene)
-                       : std::filesystem::path(overlay.scene().manifest.manifest.stem().string() + "-edited.json");
-    w.paused = o.paused;
-    w.pose_filter = o.filter != "none";
-    if (!o.screenshot.empty()) w.screenshot = o.screenshot;
-    w.max_frames = o.max_frames;
-    ui::run_overlay_window(overlay, w, [&](const pipeline::OverlayFrame& f) {
+    ui::run_overlay_window(overlay, window_settings(o, overlay.overlay()), [&](const pipeline::OverlayFrame& f) {
       if (done < total) outputs.write(f.index, f.composite);
       ++done;
     });
@@ -130,7 +135,7 @@ void run_replay(const OverlayOptions& o) {
       throw Interrupted(
           fmt::format("overlay: the window closed after {} of {} frames had played; no output written", done, total));
   } else {
-    auto sink = frame_sink(overlay.overlay(), outputs);
+    auto sink = frame_sink(outputs);
     overlay.run(o.max_frames, [&](const pipeline::OverlayFrame& f) {
       const bool go_on = sink(f);
       progress.update(++done);

@@ -65,6 +65,29 @@ case_window_under_xvfb() {
   [ "$(ls "$TMP/frames" | wc -l)" -eq 3 ] || fail "expected 3 frames"
 }
 
+case_live_window_shows_the_panels() {
+  # The live path in a window: a video played as a camera, the emulator as the tracker;
+  # xdotool saves the whole window (Ctrl+F12) while it runs: video and panels side by side.
+  command -v xdotool >/dev/null || fail "xdotool is not installed"
+  start_emulator --rate 60
+  xvfb-run -a -s "-screen 0 1280x800x24" bash -c '
+    "$1" overlay --source "video:$2/data/video/vtest.avi" --tracker "serial:$3/tty" \
+      --scene "$4/data/scenes/room/scene.json" --window --max-frames 40 --frames-dir "$3/frames" \
+      --screenshot "$3/window.png" >"$3/log" 2>&1 &
+    pid=$!
+    for i in $(seq 1 600); do xdotool search --name "lumar overlay" >/dev/null 2>&1 && break; sleep 0.1; done
+    sleep 2
+    xdotool mousemove 300 200 keydown ctrl+F12 sleep 0.5 keyup ctrl+F12
+    wait $pid' _ "$LUMAR" "$SHARED" "$TMP" "$SRC" || { cat "$TMP/log"; fail "the live window failed"; }
+  grep -q "saved the window to" "$TMP/log" || { cat "$TMP/log"; fail "no screenshot of the window"; }
+  # vtest.avi is 768x576: the window is 400 px wider for the panels, and 720 tall.
+  [ "$(python3 "$SRC/tests/cli/png_tool.py" size "$TMP/window.png")" = "1168 720" ] || fail "not video + panels"
+  local colours
+  colours=$(python3 "$SRC/tests/cli/png_tool.py" distinct "$TMP/window.png" 768 0 400 200)
+  [ "$colours" -gt 8 ] || fail "the panel looks empty ($colours colours; the cleared background is 1)"
+  [ "$(ls "$TMP/frames" | wc -l)" -ge 2 ] || fail "too few frames written"
+}
+
 case_window_without_display_fails_cleanly() {
   "$LUMAR" overlay --recording "$REC" --window --max-frames 1 >"$TMP/out" 2>"$TMP/err"
   status=$?

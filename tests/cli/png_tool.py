@@ -2,6 +2,8 @@
 
   png_tool.py black-border FILE      share of black pixels on the ring 1 px inside the border
   png_tool.py mean-abs-diff A B      mean absolute difference per channel value
+  png_tool.py size FILE              width and height
+  png_tool.py distinct FILE X Y W H  distinct colours in a rectangle (text and images: many)
 """
 import struct
 import sys
@@ -60,10 +62,19 @@ def mean_abs_diff(a, b):
     return total / (wa * ha * bpa)
 
 
+def distinct(path, x0, y0, w, h):
+    _, _, bpp, rows = read_png(path)
+    return len({bytes(rows[y][x * bpp:x * bpp + 3]) for y in range(y0, y0 + h) for x in range(x0, x0 + w)})
+
+
 if __name__ == '__main__':
     if sys.argv[1] == 'black-border':
         print('%.4f' % black_border(sys.argv[2]))
     elif sys.argv[1] == 'mean-abs-diff':
         print('%.4f' % mean_abs_diff(sys.argv[2], sys.argv[3]))
+    elif sys.argv[1] == 'size':
+        print('%d %d' % read_png(sys.argv[2])[:2])
+    elif sys.argv[1] == 'distinct':
+        print(distinct(sys.argv[2], *map(int, sys.argv[3:7])))
     else:
         sys.exit('unknown command ' + sys.argv[1])

@@ -26,7 +26,7 @@ int max_abs_diff(const cv::Mat& a, const cv::Mat& b) {
   return int(worst);
 }
 
-TEST(WindowContext, PresentShowsTheImageExactly) {
+TEST(WindowContext, PresentInCornerShowsTheImageExactly) {
   gl::WindowContext window(256, 200, "lumar window test");
   std::printf("window renderer: %s\n", window.renderer_name().c_str());
   EXPECT_FALSE(window.should_close());
@@ -34,17 +34,21 @@ TEST(WindowContext, PresentShowsTheImageExactly) {
   const cv::Mat image = test_pattern(256, 200);
   for (int frame = 0; frame < 2; ++frame) {  // the second frame checks that re-presenting works
     const cv::Mat shown = frame == 0 ? image : cv::Mat(cv::Scalar::all(255) - image);
-    window.present(shown);
+    cv::Mat back;
+    window.present_in_corner(shown, [&] { back = window.read_back_buffer(); });
     window.poll_events();
+    EXPECT_EQ(max_abs_diff(back, shown), 0);  // what was drawn before the swap
     const cv::Mat front = window.read_front_buffer();
     ASSERT_EQ(front.size(), shown.size());
     const int worst = max_abs_diff(front, shown);
     std::printf("frame %d: max |diff| %d levels\n", frame, worst);
     EXPECT_LE(worst, 1);
   }
-  // An image of another size is scaled to fill the window.
-  window.present(cv::Mat(50, 70, CV_8UC3, cv::Scalar(10, 200, 90)));
-  EXPECT_LE(max_abs_diff(window.read_front_buffer(), cv::Mat(200, 256, CV_8UC3, cv::Scalar(10, 200, 90))), 1);
+  // A smaller image sits at its own size in the top-left corner; the rest is cleared.
+  window.present_in_corner(cv::Mat(50, 70, CV_8UC3, cv::Scalar(10, 200, 90)), {});
+  const cv::Mat front = window.read_front_buffer();
+  EXPECT_LE(max_abs_diff(front(cv::Rect(0, 0, 70, 50)), cv::Mat(50, 70, CV_8UC3, cv::Scalar(10, 200, 90))), 1);
+  EXPECT_LE(max_abs_diff(front(cv::Rect(70, 50, 186, 150)), cv::Mat(150, 186, CV_8UC3, cv::Scalar(33, 31, 31))), 1);
 }
 
 TEST(WindowContext, RendererDrawsInTheWindowsContext) {
@@ -53,7 +57,7 @@ TEST(WindowContext, RendererDrawsInTheWindowsContext) {
   const cv::Mat video = test_pattern(160, 120);
   const cv::Mat out = renderer.render_overlay(video, Pose{}, 1.0);
   EXPECT_EQ(max_abs_diff(out, video), 0);  // no objects: the video round-trips
-  window.present(out);
+  window.present_in_corner(out, {});
   EXPECT_LE(max_abs_diff(window.read_front_buffer(), video), 1);
 }
 

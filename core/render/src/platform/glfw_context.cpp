@@ -90,9 +90,9 @@ void WindowContext::wait_events(double seconds) { glfwWaitEventsTimeout(seconds)
 
 GLFWwindow* WindowContext::window_handle() { return impl_->window; }
 
-void WindowContext::draw_image(const cv::Mat& bgr8, bool in_corner) {
+void WindowContext::present_in_corner(const cv::Mat& bgr8, const std::function<void()>& draw_over) {
   if (bgr8.type() != CV_8UC3 || bgr8.empty())
-    throw InputError("OpenGL window: present needs a non-empty BGR8 (CV_8UC3) image");
+    throw InputError("OpenGL window: present_in_corner needs a non-empty BGR8 (CV_8UC3) image");
   make_current();
   Impl& w = *impl_;
   if (bgr8.cols != w.image_width || bgr8.rows != w.image_height) {
@@ -111,29 +111,16 @@ void WindowContext::draw_image(const cv::Mat& bgr8, bool in_corner) {
   glDrawBuffer(GL_BACK);
   glDisable(GL_SCISSOR_TEST);
   glDisable(GL_FRAMEBUFFER_SRGB);
-  if (in_corner) {
-    glViewport(0, 0, fb_width, fb_height);
-    glClearColor(0.12f, 0.12f, 0.13f, 1.0f);
-    glClear(GL_COLOR_BUFFER_BIT);
-  }
+  glViewport(0, 0, fb_width, fb_height);
+  glClearColor(0.12f, 0.12f, 0.13f, 1.0f);
+  glClear(GL_COLOR_BUFFER_BIT);
   // Texel row 0 (the top row) goes to the window's top edge: flip the destination.
-  const int x1 = in_corner ? bgr8.cols : fb_width, y0 = in_corner ? fb_height - bgr8.rows : 0;
-  const bool same_size = x1 == bgr8.cols && fb_height - y0 == bgr8.rows;
-  glBlitNamedFramebuffer(w.image_fbo.get(), 0, 0, 0, bgr8.cols, bgr8.rows, 0, fb_height, x1, y0, GL_COLOR_BUFFER_BIT,
-                         same_size ? GL_NEAREST : GL_LINEAR);
-  check_gl_errors("WindowContext::present");
-}
-
-void WindowContext::present(const cv::Mat& bgr8) {
-  draw_image(bgr8, false);
-  glfwSwapBuffers(impl_->window);
-}
-
-void WindowContext::present_in_corner(const cv::Mat& bgr8, const std::function<void()>& draw_over) {
-  draw_image(bgr8, true);
-  if (draw_over) draw_over();
+  glBlitNamedFramebuffer(w.image_fbo.get(), 0, 0, 0, bgr8.cols, bgr8.rows, 0, fb_height, bgr8.cols,
+                         fb_height - bgr8.rows, GL_COLOR_BUFFER_BIT, GL_NEAREST);
   check_gl_errors("WindowContext::present_in_corner");
-  glfwSwapBuffers(impl_->window);
+  if (draw_over) draw_over();
+  check_gl_errors("WindowContext::present_in_corner, drawing over");
+  glfwSwapBuffers(w.window);
 }
 
 cv::Mat WindowContext::read_back_buffer() {

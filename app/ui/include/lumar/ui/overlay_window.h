@@ -1,7 +1,8 @@
 #pragma once
-// The interactive overlay: a recording replayed in a window, with Dear ImGui panels
-// beside the composite (docs/interactive.md):
-//  - Transport: play/pause, step, seek, speed, loop.
+// The interactive overlay: a recording replayed, or a camera live, in a window with Dear
+// ImGui panels beside the composite (docs/interactive.md):
+//  - Transport (replay): play/pause, step, seek, speed, loop, the poses; or the camera's
+//    and the tracker's status (live).
 //  - Objects: select, add a mesh from a path, remove, albedo, scale.
 //  - Placement: a click on the video rests the selected object where the click's ray meets
 //    the proxy; a drag slides it over the surface; the wheel, Q/E or the panel's buttons
@@ -17,6 +18,7 @@
 #include <functional>
 #include <opencv2/core.hpp>
 
+#include "lumar/pipeline/live_overlay.h"
 #include "lumar/pipeline/replay_overlay.h"
 
 namespace lumar::ui {
@@ -39,5 +41,13 @@ struct OverlayWindowSettings {
 // calling it.
 void run_overlay_window(pipeline::ReplayOverlay& replay, const OverlayWindowSettings& settings,
                         const std::function<void(const pipeline::OverlayFrame&)>& played);
+
+// The live path in the window (`pipeline::LiveOverlay` made with a window with
+// window_panel_width = kPanelWidth): the camera's and the tracker's status, and the same
+// panels, one window frame per composited camera frame, until the source ends, a stop
+// signal, or the window closes. `shown` sees each composited frame (for outputs).
+// save_scene and screenshot apply; paused, loop, pose_filter and max_frames do not.
+void run_live_overlay_window(pipeline::LiveOverlay& live, const OverlayWindowSettings& settings,
+                             const std::function<void(const pipeline::OverlayFrame&)>& shown);
 
 }  // namespace lumar::ui

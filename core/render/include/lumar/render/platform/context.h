@@ -40,12 +40,10 @@ class WindowContext : public Context {
   void poll_events();
   // Waits up to `seconds` for an event (input, a resize), then handles what came.
   void wait_events(double seconds);
-  // Draws a BGR8 image (top row first) over the whole window, scaled if the sizes
-  // differ, and swaps buffers.
-  void present(const cv::Mat& bgr8);
-  // Draws a BGR8 image at its own size in the window's top-left corner, clears the rest,
-  // calls `draw_over` (a user interface's draw calls, in the window's framebuffer) and
-  // swaps buffers. Window pixel (x, y) from the top-left shows image pixel (x, y).
+  // Draws a BGR8 image (top row first) at its own size in the window's top-left corner,
+  // clears the rest, calls `draw_over` (a user interface's draw calls, in the window's
+  // framebuffer; may be empty) and swaps buffers. Window pixel (x, y) from the top-left
+  // shows image pixel (x, y).
   void present_in_corner(const cv::Mat& bgr8, const std::function<void()>& draw_over);
   // What has been drawn into the back buffer so far (call it inside present_in_corner's
   // draw_over, after the user interface drew): the whole window, BGR8, top row first.
@@ -60,7 +58,6 @@ class WindowContext : public Context {
   struct Impl;
   std::unique_ptr<Impl> impl_;
   GLFWwindow* window_handle();
-  void draw_image(const cv::Mat& bgr8, bool in_corner);
 };
 
 }  // namespace lumar::gl

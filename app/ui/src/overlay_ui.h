@@ -1,0 +1,513 @@
+#pragma once
+// What the interactive window shows and does whatever feeds it frames (a replay with its
+// transport, or a live camera with its status): the composite with its debug views, and
+// the panels for objects, lighting, quality and files; placing objects with the mouse and
+// the keyboard; messages for what failed. One ImGui frame per call of begin_frame ...
+// present. Private to lumar_ui (overlay_window.cpp runs it).
+#define GLFW_INCLUDE_NONE
+#include <GLFW/glfw3.h>
+#include <backends/imgui_impl_glfw.h>
+#include <backends/imgui_impl_opengl3.h>
+#include <imgui.h>
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <array>
+#include <deque>
+#include <functional>
+#include <glm/gtc/matrix_transform.hpp>
+#include <optional>
+#include <string>
+
+#include "lumar/base/error.h"
+#include "lumar/calib/image_file.h"
+#include "lumar/lighting/shadows/shadow_occlusion.h"
+#include "lumar/pipeline/overlay.h"
+#include "lumar/scene/scene.h"
+#include "lumar/ui/debug_views.h"
+#include "lumar/ui/overlay_window.h"
+#include "scene_editor.h"
+
+namespace lumar::ui {
+
+// Dear ImGui's context and its GLFW and OpenGL 3 backends, for one window's life.
+// `on_key` is installed first, so that ImGui's backend passes every key on to it.
+class ImGuiSession {
+ public:
+  ImGuiSession(GLFWwindow* window, GLFWkeyfun on_key) {
+    glfwSetKeyCallback(window, on_key);
+    IMGUI_CHECKVERSION();
+    ImGui::CreateContext();
+    ImGui::GetIO().IniFilename = nullptr;  // no imgui.ini beside the user's files
+    ImGui::StyleColorsDark();
+    ImGui_ImplGlfw_InitForOpenGL(window, true);
+    ImGui_ImplOpenGL3_Init("#version 410 core");
+  }
+  ~ImGuiSession() {
+    ImGui_ImplOpenGL3_Shutdown();
+    ImGui_ImplGlfw_Shutdown();
+    ImGui::DestroyContext();
+  }
+  ImGuiSession(const ImGuiSession&) = delete;
+  ImGuiSession& operator=(const ImGuiSession&) = delete;
+};
+
+// One composite's time per stage, for the stats plot.
+struct FrameStats {
+  float total = 0, shadows = 0, objects = 0, background = 0, other = 0;
+};
+
+constexpr std::array<const char*, 2> kMethods{"volume", "sh9"};
+constexpr double kNudgeM = 0.01, kTurnDeg = 5.0, kDragPx = 3.0;
+
+struct KeyPress {
+  int key = 0, mods = 0;
+  bool repeat = false;
+};
+
+class OverlayUi {
+ public:
+  OverlayUi(pipeline::Overlay& overlay, gl::WindowContext& window, const OverlayWindowSettings& settings)
+      : overlay_(overlay),
+        window_(window),
+        editor_(overlay),
+        imgui_(window.glfw_window(), &OverlayUi::on_key),
+        save_path_(settings.save_scene.string()),
+        screenshot_path_(settings.screenshot.string()) {
+    features_ = overlay_.compositor().renderer().features();
+    glfwSetWindowUserPointer(window_.glfw_window(), this);
+  }
+  ~OverlayUi() { glfwSetWindowUserPointer(window_.glfw_window(), nullptr); }
+  OverlayUi(const OverlayUi&) = delete;
+  OverlayUi& operator=(const OverlayUi&) = delete;
+
+  // Starts a frame: ImGui's, then the mouse (placing against the last composite's pose)
+  // and the keys, which `source_keys` sees first (it returns true for those it used).
+  void begin_frame(const std::function<bool(const KeyPress&)>& source_keys) {
+    ImGui_ImplOpenGL3_NewFrame();
+    ImGui_ImplGlfw_NewFrame();
+    ImGui::NewFrame();
+    handle_mouse();
+    handle_keys(source_keys);
+  }
+
+  // The panel beside the video: `source_panel` (transport, or live status) first.
+  void panels(const std::function<void()>& source_panel) { panel_window(source_panel); }
+
+  // The lighting switches, before each composite.
+  void apply_switches() {
+    overlay_.compositor().set_shadows_enabled(shadows_, object_shadows_);
+    overlay_.compositor().set_features(features_);
+  }
+
+  // A new composite to show (and to place against), and its stage times.
+  void show(const pipeline::OverlayFrame& out, const pipeline::StageTimes& before) {
+    image_ = out.composite;
+    pose_ = out.T_world_camera;
+    const pipeline::StageTimes& t = overlay_.times();
+    FrameStats s;
+    s.shadows = float(t.shadows - before.shadows);
+    s.objects = float(t.objects - before.objects);
+    s.background = float(t.background - before.background + t.upload - before.upload);
+    s.total = float(t.total() - before.total());
+    s.other = s.total - s.shadows - s.objects - s.background;
+    stats_.push_back(s);
+    if (stats_.size() > 240) stats_.pop_front();
+  }
+
+  // Ends the frame: the composite with its debug views, the panels, the swap.
+  void present() {
+    ImGui::Render();
+    const cv::Mat shown =
+        debug_.any() && pose_ ? draw_debug_views(image_, overlay_.compositor(), *pose_, debug_) : image_;
+    window_.present_in_corner(shown, [&] {
+      ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
+      if (window_shot_) {
+        window_shot_ = false;
+        attempt("screenshot", [&] {
+          calib::write_image_atomically(screenshot_path_, window_.read_back_buffer());
+          say("saved the window to " + screenshot_path_, false);
+        });
+      }
+    });
+  }
+
+  // Something changed that the composite shows: composite again (a paused replay).
+  bool dirty() const { return dirty_; }
+  void set_dirty(bool dirty) { dirty_ = dirty; }
+  bool has_image() const { return !image_.empty(); }
+  const std::optional<Pose>& pose() const { return pose_; }
+
+  // --- actions that may fail: a message in the panel --------------------------------
+  void say(const std::string& text, bool error) {
+    message_ = text;
+    message_error_ = error;
+    (error ? spdlog::warn("{}", text) : spdlog::info("{}", text));
+  }
+
+  template <class F>
+  void attempt(const char* what, F&& f) {
+    try {
+      f();
+    } catch (const std::exception& e) {  // bad input, or a file that cannot be written: the window goes on
+      say(std::string(what) + ": " + e.what(), true);
+    }
+  }
+
+ private:
+  // --- placement -------------------------------------------------------------------
+  std::optional<SurfacePoint> surface_under(const ImVec2& mouse) {
+    if (!pose_) {
+      say("no camera pose for this frame: nothing to place against", true);
+      return std::nullopt;
+    }
+    return surface_at_pixel(editor_.proxy(), overlay_.compositor().output_camera(), *pose_,
+                            glm::dvec2(mouse.x, mouse.y));
+  }
+
+  bool over_video(const ImVec2& p) const { return p.x >= 0 && p.y >= 0 && p.x < image_.cols && p.y < image_.rows; }
+
+  void handle_mouse() {
+    const ImGuiIO& io = ImGui::GetIO();
+    if (io.WantCaptureMouse || editor_.object_count() == 0) {
+      pressed_ = false;
+      return;
+    }
+    const std::size_t i = selected();
+    if (ImGui::IsMouseClicked(ImGuiMouseButton_Left) && over_video(io.MousePos)) {
+      pressed_ = true;
+      dragging_ = false;
+      press_pos_ = io.MousePos;
+      press_pose_ = editor_.scene().objects[i].T_world_model;
+      press_rest_ = editor_.rest(i);
+      press_surface_ = surface_under(io.MousePos);
+    }
+    const bool released = pressed_ && ImGui::IsMouseReleased(ImGuiMouseButton_Left);
+    if (pressed_ && (ImGui::IsMouseDown(ImGuiMouseButton_Left) || released)) {
+      const float dx = io.MousePos.x - press_pos_.x, dy = io.MousePos.y - press_pos_.y;
+      if (!dragging_ && dx * dx + dy * dy > kDragPx * kDragPx) dragging_ = true;
+      // To where the mouse is, also on the frame it is let go.
+      if (dragging_ && press_surface_)
+        if (const auto here = surface_under(io.MousePos)) {
+          // Along the surface it was grabbed on: the offset between the rays' two hits.
+          glm::dvec3 offset = here->point - press_surface_->point;
+          offset -= glm::dot(offset, press_rest_.normal) * press_rest_.normal;
+          editor_.slide(i, press_pose_, press_rest_, offset);
+          dirty_ = true;
+        }
+    }
+    if (released) {
+      pressed_ = false;
+      if (!dragging_) {
+        if (press_surface_) {
+          editor_.place(i, *press_surface_);
+          dirty_ = true;
+        } else if (pose_) {
+          say("the click's ray meets no proxy surface", true);
+        }
+      }
+    }
+    if (io.MouseWheel != 0 && over_video(io.MousePos)) {
+      editor_.turn(i, kTurnDeg * io.MouseWheel);
+      dirty_ = true;
+    }
+  }
+
+  // Arrow keys slide the selected object along its surface, in the camera's right and
+  // forward directions laid on it.
+  void nudge(double right, double forward) {
+    if (!pose_ || editor_.object_count() == 0) return;
+    const std::size_t i = selected();
+    const glm::dvec3 n = editor_.rest(i).normal;
+    glm::dvec3 r = pose_->rotation * glm::dvec3(1, 0, 0), f = pose_->rotation * glm::dvec3(0, 0, 1);
+    r = glm::normalize(r - glm::dot(r, n) * n);
+    f = glm::normalize(f - glm::dot(f, n) * n);
+    editor_.slide(i, editor_.scene().objects[i].T_world_model, editor_.rest(i), kNudgeM * (right * r + forward * f));
+    dirty_ = true;
+  }
+
+  // Every key press, kept until the frame handles it: ImGui 1.86 samples keys once per
+  // frame, and a press and release between two slow frames would be lost.
+  static void on_key(GLFWwindow* window, int key, int /*scancode*/, int action, int mods) {
+    if (auto* self = static_cast<OverlayUi*>(glfwGetWindowUserPointer(window)); self && action != GLFW_RELEASE)
+      self->keys_.push_back({key, mods, action == GLFW_REPEAT});
+  }
+
+  void handle_keys(const std::function<bool(const KeyPress&)>& source_keys) {
+    std::vector<KeyPress> keys;
+    keys.swap(keys_);
+    if (ImGui::GetIO().WantCaptureKeyboard) return;  // typed into a field
+    for (const KeyPress& k : keys) {
+      if (source_keys && source_keys(k)) continue;
+      const bool ctrl = k.mods & GLFW_MOD_CONTROL;
+      const double step = (k.mods & GLFW_MOD_SHIFT) ? 5.0 : 1.0;
+      switch (k.key) {
+        case GLFW_KEY_LEFT:
+          nudge(-step, 0);
+          break;
+        case GLFW_KEY_RIGHT:
+          nudge(step, 0);
+          break;
+        case GLFW_KEY_UP:
+          nudge(0, step);
+          break;
+        case GLFW_KEY_DOWN:
+          nudge(0, -step);
+          break;
+        case GLFW_KEY_Q:
+          turn_selected(kTurnDeg * step);
+          break;
+        case GLFW_KEY_E:
+          turn_selected(-kTurnDeg * step);
+          break;
+        default:
+          break;
+      }
+      if (k.repeat) continue;  // held: only the moves above repeat
+      switch (k.key) {
+        case GLFW_KEY_TAB:
+          if (editor_.object_count() > 0) selected_ = (selected() + 1) % editor_.object_count();
+          break;
+        case GLFW_KEY_DELETE:
+          remove_selected();
+          break;
+        case GLFW_KEY_H:
+          shadows_ = !shadows_, dirty_ = true;
+          break;
+        case GLFW_KEY_S:
+          if (ctrl) save_scene();
+          break;
+        case GLFW_KEY_O:
+          if (ctrl) focus_mesh_field_ = true;
+          break;
+        case GLFW_KEY_F12:
+          with_panels_ = ctrl;  // Ctrl+F12: the whole window
+          save_screenshot();
+          break;
+        default:
+          break;
+      }
+    }
+  }
+
+  void turn_selected(double degrees) {
+    if (editor_.object_count() == 0) return;
+    editor_.turn(selected(), degrees);
+    dirty_ = true;
+  }
+
+  std::size_t selected() const { return std::min(selected_, std::max<std::size_t>(1, editor_.object_count()) - 1); }
+
+  void save_scene() {
+    attempt("save", [&] {
+      editor_.save(save_path_);
+      say("saved the scene to " + save_path_, false);
+    });
+  }
+
+  // The composite alone, or with `with_panels` the whole window once this frame is drawn.
+  void save_screenshot() {
+    attempt("screenshot", [&] {
+      if (screenshot_path_.empty()) throw InputError("give a file name for the screenshot");
+      if (with_panels_) {
+        window_shot_ = true;
+        return;
+      }
+      calib::write_image_atomically(screenshot_path_, image_);
+      say("saved the composite to " + screenshot_path_, false);
+    });
+  }
+
+  void add_object() {
+    attempt("add", [&] {
+      // On the surface under the middle of the view, else the middle of the movement box.
+      const auto& camera = overlay_.compositor().output_camera();
+      std::optional<SurfacePoint> at;
+      if (pose_) at = surface_at_pixel(editor_.proxy(), camera, *pose_, {camera.cx, camera.cy});
+      if (!at) {
+        const Scene& m = editor_.scene().manifest;
+        at = SurfacePoint{glm::dvec3(0.5 * (m.movement_min.x + m.movement_max.x), m.movement_min.y,
+                                     0.5 * (m.movement_min.z + m.movement_max.z)),
+                          glm::dvec3(0, 1, 0)};
+      }
+      selected_ = editor_.add(add_path_.data(), *at);
+      dirty_ = true;
+      say("added " + editor_.scene().objects[selected_].name, false);
+    });
+  }
+
+  void remove_selected() {
+    if (editor_.object_count() == 0) return;
+    const std::string name = editor_.scene().objects[selected()].name;
+    attempt("remove", [&] {
+      editor_.remove(selected());
+      dirty_ = true;
+      say("removed " + name, false);
+    });
+  }
+
+  void panel_window(const std::function<void()>& source_panel) {
+    const ImGuiIO& io = ImGui::GetIO();
+    ImGui::SetNextWindowPos(ImVec2(float(image_.cols), 0));
+    ImGui::SetNextWindowSize(ImVec2(float(kPanelWidth), io.DisplaySize.y));
+    ImGui::Begin("lumar", nullptr, ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoResize | ImGuiWindowFlags_NoCollapse);
+    if (!message_.empty())
+      ImGui::TextColored(message_error_ ? ImVec4(1.0f, 0.45f, 0.4f, 1.0f) : ImVec4(0.6f, 0.9f, 0.6f, 1.0f), "%s",
+                         message_.c_str());
+    if (source_panel) source_panel();
+    objects_panel();
+    lighting_panel();
+    quality_panel();
+    stats_panel();
+    file_panel();
+    ImGui::End();
+  }
+
+  void objects_panel() {
+    if (!ImGui::CollapsingHeader("Objects", ImGuiTreeNodeFlags_DefaultOpen)) return;
+    const LoadedScene& scene = editor_.scene();
+    for (std::size_t i = 0; i < scene.objects.size(); ++i) {
+      const std::string label = scene.objects[i].name + (scene.objects[i].path.empty() ? "" : " (walks its path)");
+      if (ImGui::Selectable(label.c_str(), i == selected())) selected_ = i;
+    }
+    if (scene.objects.empty()) ImGui::TextDisabled("no objects: add one below");
+    if (focus_mesh_field_) ImGui::SetKeyboardFocusHere(), focus_mesh_field_ = false;
+    const bool entered =
+        ImGui::InputText("mesh", add_path_.data(), add_path_.size(), ImGuiInputTextFlags_EnterReturnsTrue);
+    ImGui::SameLine();
+    if (ImGui::Button("Add") || entered) add_object();
+    if (scene.objects.empty()) return;
+    const std::size_t i = selected();
+    glm::vec3 albedo = scene.objects[i].albedo;
+    if (ImGui::ColorEdit3("albedo", &albedo.x)) editor_.set_albedo(i, albedo), dirty_ = true;
+    float scale = float(editor_.scale_factor(i));
+    if (ImGui::SliderFloat("scale", &scale, 0.2f, 5.0f, "%.2fx", ImGuiSliderFlags_Logarithmic))
+      editor_.set_scale_factor(i, scale), dirty_ = true;
+    if (ImGui::Button("Turn -15")) editor_.turn(i, -15), dirty_ = true;
+    ImGui::SameLine();
+    if (ImGui::Button("Turn +15")) editor_.turn(i, 15), dirty_ = true;
+    ImGui::SameLine();
+    if (ImGui::Button("Remove")) remove_selected();
+    const glm::dvec3 p = editor_.rest(selected()).point;
+    ImGui::Text("rests at (%.3f, %.3f, %.3f) m", p.x, p.y, p.z);
+    ImGui::TextDisabled("click: place  drag: slide  wheel, Q/E: turn");
+    ImGui::TextDisabled("arrows: nudge 1 cm (shift: 5)  tab: next");
+    ImGui::TextDisabled("h: shadows  ctrl+O: mesh  ctrl+S: save");
+  }
+
+  void lighting_panel() {
+    if (!ImGui::CollapsingHeader("Lighting", ImGuiTreeNodeFlags_DefaultOpen)) return;
+    const std::string& method = editor_.scene().manifest.lighting.method;
+    if (ImGui::BeginCombo("method", method.c_str())) {
+      for (const char* m : kMethods)
+        if (ImGui::Selectable(m, method == m))
+          attempt("lighting", [&] {
+            editor_.set_lighting_method(m);
+            dirty_ = true;
+          });
+      ImGui::EndCombo();
+    }
+    dirty_ |= ImGui::Checkbox("shadows", &shadows_);
+    ImGui::SameLine();
+    dirty_ |= ImGui::Checkbox("objects shadow objects", &object_shadows_);
+    dirty_ |= ImGui::Checkbox("antialiasing", &features_.antialiasing);
+    ImGui::SameLine();
+    dirty_ |= ImGui::Checkbox("self-occlusion", &features_.self_occlusion);
+    dirty_ |= ImGui::Checkbox("noise", &features_.noise);
+    ImGui::SameLine();
+    dirty_ |= ImGui::Checkbox("blur", &features_.blur);
+    float exposure = float(overlay_.exposure_scale());
+    if (ImGui::SliderFloat("exposure", &exposure, 0.25f, 4.0f, "%.2fx", ImGuiSliderFlags_Logarithmic))
+      overlay_.set_exposure_scale(exposure), dirty_ = true;
+  }
+
+  // The knobs that trade speed for accuracy, the pose filter, and what to draw over the video.
+  void quality_panel() {
+    if (!ImGui::CollapsingHeader("Quality and debug views")) return;
+    Compositor& compositor = overlay_.compositor();
+    ShadowQuality q = compositor.shadow_quality();
+    ImGui::SliderInt("emitter patches", &q.emitter_patches, 4, 256);
+    const bool patches_done = ImGui::IsItemDeactivatedAfterEdit();
+    ImGui::SliderInt("lines per patch", &q.lines_per_patch, 1, 32);
+    if (patches_done || ImGui::IsItemDeactivatedAfterEdit())
+      attempt("shadow quality", [&] {
+        compositor.set_shadow_quality(q);
+        dirty_ = true;
+      });
+    if (const LineShadows* lines = compositor.shadows())
+      ImGui::Text("%zu radiosity lines, %u emitter patches", lines->lines().lines.size(), lines->lines().patch_count);
+    bool adapt = overlay_.live_lighting() != nullptr;
+    if (ImGui::Checkbox("follow the room's lighting (every 10 frames)", &adapt))
+      overlay_.set_adapt_lighting_every(adapt ? 10 : 0), dirty_ = true;
+    ImGui::Checkbox("proxy wireframe", &debug_.proxy_wireframe);
+    ImGui::SameLine();
+    ImGui::Checkbox("receivers", &debug_.receivers);
+    ImGui::Checkbox("emitter samples", &debug_.emitters);
+    ImGui::SameLine();
+    ImGui::Checkbox("irradiance probes", &debug_.probes);
+  }
+
+  void stats_panel() {
+    if (!ImGui::CollapsingHeader("Stats", ImGuiTreeNodeFlags_DefaultOpen) || stats_.empty()) return;
+    std::vector<float> totals;
+    FrameStats mean;
+    for (const FrameStats& s : stats_) {
+      totals.push_back(s.total);
+      mean.total += s.total, mean.shadows += s.shadows, mean.objects += s.objects;
+      mean.background += s.background, mean.other += s.other;
+    }
+    const float n = float(stats_.size());
+    const std::string title =
+        fmt::format("{:.1f} ms/frame ({:.1f} frames/s)", mean.total / n, 1000.0f * n / mean.total);
+    ImGui::PlotLines("##total", totals.data(), int(totals.size()), 0, title.c_str(), 0.0f, FLT_MAX,
+                     ImVec2(float(kPanelWidth) - 20.0f, 60.0f));
+    ImGui::Text("objects %.1f  shadows %.1f  video %.1f  other %.1f ms", mean.objects / n, mean.shadows / n,
+                mean.background / n, mean.other / n);
+  }
+
+  void file_panel() {
+    if (!ImGui::CollapsingHeader("File", ImGuiTreeNodeFlags_DefaultOpen)) return;
+    input_path("scene", save_path_);
+    ImGui::SameLine();
+    if (ImGui::Button("Save")) save_scene();
+    input_path("image", screenshot_path_);
+    ImGui::SameLine();
+    if (ImGui::Button("Screenshot")) save_screenshot();
+    ImGui::Checkbox("with the panels", &with_panels_);
+  }
+
+  static void input_path(const char* label, std::string& path) {
+    std::array<char, 1024> buffer{};
+    path.copy(buffer.data(), buffer.size() - 1);
+    if (ImGui::InputText(label, buffer.data(), buffer.size())) path = buffer.data();
+  }
+
+  pipeline::Overlay& overlay_;
+  gl::WindowContext& window_;
+  SceneEditor editor_;
+  ImGuiSession imgui_;
+  std::optional<Pose> pose_;
+  cv::Mat image_;
+  bool dirty_ = true;
+
+  // editing
+  std::size_t selected_ = 0;
+  bool pressed_ = false, dragging_ = false, focus_mesh_field_ = false;
+  ImVec2 press_pos_;
+  glm::dmat4 press_pose_{1.0};
+  SurfacePoint press_rest_;
+  std::optional<SurfacePoint> press_surface_;
+  std::array<char, 1024> add_path_{};
+
+  // lighting
+  bool shadows_ = true, object_shadows_ = true;
+  gl::CompositeFeatures features_;
+  DebugViews debug_;
+
+  std::vector<KeyPress> keys_;
+  std::deque<FrameStats> stats_;
+  std::string save_path_, screenshot_path_, message_;
+  bool message_error_ = false, with_panels_ = false, window_shot_ = false;
+};
+
+}  // namespace lumar::ui
