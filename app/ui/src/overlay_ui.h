@@ -447,22 +447,28 @@ class OverlayUi {
     ImGui::Checkbox("irradiance probes", &debug_.probes);
   }
 
+  // Each stage's milliseconds over the last composites, one plot per stage on the
+  // total's scale, with its mean.
   void stats_panel() {
     if (!ImGui::CollapsingHeader("Stats", ImGuiTreeNodeFlags_DefaultOpen) || stats_.empty()) return;
-    std::vector<float> totals;
-    FrameStats mean;
-    for (const FrameStats& s : stats_) {
-      totals.push_back(s.total);
-      mean.total += s.total, mean.shadows += s.shadows, mean.objects += s.objects;
-      mean.background += s.background, mean.other += s.other;
+    const std::pair<const char*, float FrameStats::*> stages[] = {{"total", &FrameStats::total},
+                                                                  {"objects", &FrameStats::objects},
+                                                                  {"shadows", &FrameStats::shadows},
+                                                                  {"video", &FrameStats::background},
+                                                                  {"other", &FrameStats::other}};
+    float top = 1.0f;
+    for (const FrameStats& s : stats_) top = std::max(top, s.total);
+    for (const auto& [name, member] : stages) {
+      std::vector<float> values;
+      float sum = 0;
+      for (const FrameStats& s : stats_) values.push_back(s.*member), sum += s.*member;
+      const float mean = sum / float(values.size());
+      const std::string label = member == &FrameStats::total
+                                    ? fmt::format("total {:.1f} ms ({:.1f} frames/s)", mean, 1000.0f / mean)
+                                    : fmt::format("{} {:.1f} ms", name, mean);
+      ImGui::PlotLines(("##" + std::string(name)).c_str(), values.data(), int(values.size()), 0, label.c_str(), 0.0f,
+                       top, ImVec2(float(kPanelWidth) - 20.0f, member == &FrameStats::total ? 44.0f : 22.0f));
     }
-    const float n = float(stats_.size());
-    const std::string title =
-        fmt::format("{:.1f} ms/frame ({:.1f} frames/s)", mean.total / n, 1000.0f * n / mean.total);
-    ImGui::PlotLines("##total", totals.data(), int(totals.size()), 0, title.c_str(), 0.0f, FLT_MAX,
-                     ImVec2(float(kPanelWidth) - 20.0f, 60.0f));
-    ImGui::Text("objects %.1f  shadows %.1f  video %.1f  other %.1f ms", mean.objects / n, mean.shadows / n,
-                mean.background / n, mean.other / n);
   }
 
   void file_panel() {
