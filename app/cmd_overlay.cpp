@@ -3,11 +3,13 @@
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
+#include <chrono>
 #include <memory>
 #include <optional>
 
 #include "commands.h"
 #include "lumar/base/error.h"
+#include "lumar/base/output_file.h"
 #include "lumar/base/stop_signal.h"
 #include "lumar/pipeline/live_overlay.h"
 #include "lumar/pipeline/output_files.h"
@@ -24,7 +26,7 @@ struct OverlayOptions {
   std::string filter = "none", without;
   double blur_sigma = -1.0;
   bool window = false, no_cache = false, allow_incomplete = false, paused = false;
-  std::string save_scene, screenshot;
+  std::string save_scene, screenshot, stats_json;
   int max_frames = 0;
   int adapt_lighting = 0;
   pipeline::LiveOverlayOptions live;  // --source and what only the live path reads
@@ -62,6 +64,13 @@ ui::OverlayWindowSettings window_settings(const OverlayOptions& o, const pipelin
   return w;
 }
 
+// --stats-json: the run's figures, for tools (docs/formats.md, "Overlay stats").
+void write_stats(const OverlayOptions& o, const pipeline::Overlay& overlay, std::chrono::steady_clock::time_point t0) {
+  if (o.stats_json.empty()) return;
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  write_file_atomically(o.stats_json, pipeline::stage_times_json(overlay.times(), wall));
+}
+
 void report(const pipeline::Overlay& overlay) {
   if (const auto* lighting = overlay.live_lighting())
     spdlog::info("overlay: lighting scale {:.3f} after {} comparisons of the video with the map", lighting->scale(),
@@ -87,6 +96,7 @@ void run_live(OverlayOptions& o) {
   pipeline::LiveOverlay overlay(live);
   const auto& camera = overlay.overlay().compositor().output_camera();
   pipeline::OverlayOutputs outputs({o.out, o.frames_dir, "", overlay.fps(), cv::Size(camera.width, camera.height)});
+  const auto t0 = std::chrono::steady_clock::now();
   if (window) {  // the panels, and the camera's and tracker's status
     ui::run_live_overlay_window(overlay, window_settings(o, overlay.overlay()),
                                 [&](const pipeline::OverlayFrame& f) { outputs.write(f.index, f.composite); });
@@ -94,13 +104,14 @@ void run_live(OverlayOptions& o) {
     overlay.run(frame_sink(outputs));
   }
   outputs.commit();
+  write_stats(o, overlay.overlay(), t0);
   report(overlay.overlay());
 }
 
 void run_replay(const OverlayOptions& o) {
   if (o.recording.empty()) throw InputError("overlay: give --recording DIR, or --source SPEC for the live path");
-  if (o.out.empty() && o.frames_dir.empty() && o.contact_sheet.empty() && !o.window)
-    throw InputError("overlay: nothing to do; give --out, --frames-dir, --contact-sheet or --window");
+  if (o.out.empty() && o.frames_dir.empty() && o.contact_sheet.empty() && !o.window && o.stats_json.empty())
+    throw InputError("overlay: nothing to do; give --out, --frames-dir, --contact-sheet, --stats-json or --window");
   if (!o.live.rig.empty() || o.live.response || o.live.vignetting_a || o.live.vignetting_b || o.live.exposure)
     throw InputError(
         "overlay --recording: --rig, --response, --vignetting and --exposure are for --source; a "
@@ -124,6 +135,7 @@ void run_replay(const OverlayOptions& o) {
                                     cv::Size(camera.width, camera.height), total});
   pipeline::Progress progress("overlay", int(total), "frames", true);  // on a terminal only
   int done = 0;
+  const auto t0 = std::chrono::steady_clock::now();
   if (o.window) {  // interactive: the window's transport plays, edits and seeks
     ui::run_overlay_window(overlay, window_settings(o, overlay.overlay()), [&](const pipeline::OverlayFrame& f) {
       if (done < total) outputs.write(f.index, f.composite);
@@ -146,6 +158,7 @@ void run_replay(const OverlayOptions& o) {
   if (stop_requested())
     throw Interrupted(fmt::format("overlay: after {} of {} frames; no output written", done, total));
   outputs.commit();
+  write_stats(o, overlay.overlay(), t0);
   const auto& stats = overlay.replay().tracker_stats();
   spdlog::info("overlay: {} frames{}; tracker: {} records, {} rejected, {} of {} bytes lost", overlay.times().frames,
                outputs.describe(), stats.records, stats.rejected_records, stats.lost_bytes(), stats.stream_bytes);
@@ -190,6 +203,9 @@ void register_overlay(CLI::App& app) {
                   "Window: where File > Screenshot (F12; Ctrl+F12 with the panels) writes (default: "
                   "lumar-screenshot.png here)");
   cmd->add_flag("--paused", o->paused, "Window: start paused on the first frame");
+  cmd->add_option("--stats-json", o->stats_json,
+                  "Write the run's figures as JSON: frames, fps, latency_ms_mean, stages (ms per frame); with it "
+                  "--out may be left out, to composite without encoding");
   cmd->add_flag("--allow-incomplete", o->allow_incomplete,
                 "Replay a recording that was never closed (killed or crashed): its closed frames");
   cmd->add_option("--max-frames", o->max_frames, "Stop after this many frames (0 = all)")->capture_default_str();

@@ -88,6 +88,26 @@ case_live_window_shows_the_panels() {
   [ "$(ls "$TMP/frames" | wc -l)" -ge 2 ] || fail "too few frames written"
 }
 
+case_stats_json_without_encoding() {
+  # --stats-json alone: no output encoded, the run's figures as JSON. On the serial path a
+  # frame's latency is its stages end to end, so the mean latency is their sum per frame.
+  "$LUMAR" overlay --recording "$REC" --max-frames 6 --stats-json "$TMP/stats.json" >"$TMP/log" 2>&1 ||
+    { cat "$TMP/log"; fail "overlay --stats-json failed"; }
+  [ "$(ls -A "$TMP" | grep -v -e '^stats.json$' -e '^log$')" = "" ] || fail "wrote more than the stats: $(ls -A "$TMP")"
+  python3 - "$TMP/stats.json" <<'PY' || fail "bad stats file"
+import json, sys
+s = json.load(open(sys.argv[1]))
+assert s['frames'] == 6, s['frames']
+assert s['fps'] > 0
+stages = s['stages']
+for name in ('decode video', 'virtual objects', 'shadows (moved objects)', 'read back', 'encode output'):
+    assert name in stages, name
+total = sum(stages.values())
+assert abs(s['latency_ms_mean'] - total) <= 0.05 * total + 1.0, (s['latency_ms_mean'], total)
+assert 1000.0 / s['fps'] >= 0.9 * total, (s['fps'], total)  # the run's wall time holds every stage
+PY
+}
+
 case_window_without_display_fails_cleanly() {
   "$LUMAR" overlay --recording "$REC" --window --max-frames 1 >"$TMP/out" 2>"$TMP/err"
   status=$?

@@ -73,6 +73,7 @@ void LiveOverlay::run(const std::function<bool(const OverlayFrame&)>& sink) {
         const auto t0 = std::chrono::steady_clock::now();
         const bool go_on = sink(out);
         times.output += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+        times.latency += nanos_to_seconds(monotonic_now() - paired.frame.time) * 1e3;  // capture to handed on
         return go_on;
       },
       [&] {

@@ -2,6 +2,8 @@
 
 #include <fmt/format.h>
 
+#include <nlohmann/json.hpp>
+
 #include <chrono>
 #include <cstdlib>
 
@@ -167,32 +169,47 @@ OverlayFrame Overlay::composite(const capture::Frame& frame, const std::optional
   return out;
 }
 
+std::vector<std::pair<std::string, double>> StageTimes::stages() const {
+  return {{"decode video", decode},
+          {"tracker pose", pose},
+          {"lighting adaptation", lighting},
+          {"shadows (moved objects)", shadows},
+          {"upload frame", upload},
+          {"background (undistort)", background},
+          {"proxy depth", depth},
+          {"virtual objects", objects},
+          {"antialiasing", antialiasing},
+          {"camera blur", blur},
+          {"read back", readback},
+          {"encode output", output}};
+}
+
 double StageTimes::total() const {
-  return decode + pose + lighting + shadows + upload + background + depth + objects + antialiasing + blur + readback +
-         output;
+  double sum = 0;
+  for (const auto& [name, ms] : stages()) sum += ms;
+  return sum;
 }
 
 std::string format_stage_times(const StageTimes& t) {
   const int n = std::max(1, t.frames);
-  const std::pair<const char*, double> stages[] = {{"decode video", t.decode},
-                                                   {"tracker pose", t.pose},
-                                                   {"lighting adaptation", t.lighting},
-                                                   {"shadows (moved objects)", t.shadows},
-                                                   {"upload frame", t.upload},
-                                                   {"background (undistort)", t.background},
-                                                   {"proxy depth", t.depth},
-                                                   {"virtual objects", t.objects},
-                                                   {"antialiasing", t.antialiasing},
-                                                   {"camera blur", t.blur},
-                                                   {"read back", t.readback},
-                                                   {"encode output", t.output}};
   const double total = t.total();
   std::string text = fmt::format("{:<24}{:>10}{:>8}\n", "stage", "ms/frame", "share");
-  for (const auto& [name, ms] : stages)
+  for (const auto& [name, ms] : t.stages())
     text += fmt::format("{:<24}{:>10.2f}{:>7.1f}%\n", name, ms / n, total > 0 ? 100.0 * ms / total : 0.0);
   text += fmt::format("{:<24}{:>10.2f}   ({:.1f} frames/s over {} frames)\n", "total", total / n,
                       total > 0 ? 1000.0 * n / total : 0.0, t.frames);
   return text;
+}
+
+std::string stage_times_json(const StageTimes& t, double wall_seconds) {
+  const int n = std::max(1, t.frames);
+  nlohmann::json stages = nlohmann::json::object();
+  for (const auto& [name, ms] : t.stages()) stages[name] = ms / n;
+  const nlohmann::json out = {{"frames", t.frames},
+                              {"fps", wall_seconds > 0 ? t.frames / wall_seconds : 0.0},
+                              {"latency_ms_mean", t.latency / n},
+                              {"stages", stages}};
+  return out.dump(2) + "\n";
 }
 
 }  // namespace lumar::pipeline

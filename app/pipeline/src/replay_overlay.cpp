@@ -48,7 +48,8 @@ void ReplayOverlay::run(int max_frames, const std::function<bool(const OverlayFr
   StageTimes& times = overlay_->times();
   capture::Frame frame;
   for (int n = 0; max_frames <= 0 || n < max_frames; ++n) {
-    auto t0 = std::chrono::steady_clock::now();
+    const auto start = std::chrono::steady_clock::now();
+    auto t0 = start;
     if (!frames->read(frame)) break;
     times.decode += ms_since(t0);
 
@@ -60,6 +61,7 @@ void ReplayOverlay::run(int max_frames, const std::function<bool(const OverlayFr
     t0 = std::chrono::steady_clock::now();
     const bool go_on = sink(out);
     times.output += ms_since(t0);
+    times.latency += ms_since(start);
     if (!go_on) break;
   }
 }

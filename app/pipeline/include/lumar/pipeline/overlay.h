@@ -6,6 +6,8 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "lumar/calib/camera_response.h"
 #include "lumar/calib/undistortion.h"
@@ -42,8 +44,13 @@ struct OverlaySettings {
 struct StageTimes {  // milliseconds, summed over frames
   double decode = 0, pose = 0, lighting = 0, shadows = 0, upload = 0, background = 0, depth = 0, objects = 0,
          antialiasing = 0, blur = 0, readback = 0, output = 0;
+  // From a frame's start (replay: its decode; live: the middle of its exposure) to its
+  // composite handed on, summed over frames.
+  double latency = 0;
   int frames = 0;
   double total() const;  // every stage
+  // Each stage's name ("decode video", ...) and its sum, in pipeline order.
+  std::vector<std::pair<std::string, double>> stages() const;
 };
 
 struct OverlayFrame {
@@ -115,5 +122,8 @@ class Overlay {
 
 // One line per stage: mean milliseconds per frame and share of the total.
 std::string format_stage_times(const StageTimes& t);
+// The run's figures as JSON (docs/formats.md, "Overlay stats"): frames, fps (frames over
+// `wall_seconds`), latency_ms_mean, and stages (name -> mean ms per frame).
+std::string stage_times_json(const StageTimes& t, double wall_seconds);
 
 }  // namespace lumar::pipeline
