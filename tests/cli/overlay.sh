@@ -103,7 +103,7 @@ stages = s['stages']
 for name in ('decode video', 'virtual objects', 'shadows (moved objects)', 'read back', 'encode output'):
     assert name in stages, name
 total = sum(stages.values())
-assert abs(s['latency_ms_mean'] - total) <= 0.05 * total + 1.0, (s['latency_ms_mean'], total)
+assert abs(s['latency_ms_mean'] - total) <= 0.05 * total + 2.0, (s['latency_ms_mean'], total)
 assert 1000.0 / s['fps'] >= 0.9 * total, (s['fps'], total)  # the run's wall time holds every stage
 PY
 }

@@ -53,7 +53,7 @@ TEST_F(SceneWriter, EditedObjectsReadBackAtTheSameMatrices) {
     for (int c = 0; c < 4; ++c)
       for (int r = 0; r < 4; ++r)
         EXPECT_NEAR(back.objects[i].T_world_model[c][r], scene.objects[i].T_world_model[c][r], 1e-12) << i;
-  EXPECT_EQ(back.objects[1].albedo, still.albedo);
+  EXPECT_EQ(back.objects[1].albedo, scene.objects[1].albedo);  // `still` dangles after the push_back
   EXPECT_EQ(back.objects[2].name, "added");
   // The walker keeps its path: the same poses along it.
   ASSERT_FALSE(back.objects[0].path.empty());

@@ -142,12 +142,22 @@ class OverlayWindow : public ::testing::Test {
     return ready();
   }
 
-  // Holds `keys` down for a while, as the X server's test extension types them: the
-  // window queues its own shortcuts, but ImGui's text field samples keys once a frame.
+  // Holds `keys` ("ctrl+o") down for a while as the X server's test extension types them:
+  // the modifiers first and released last, so that the key's autorepeat never comes
+  // without them (a bare "o" would be typed into a focused field). 0.4 s: the window
+  // queues its own shortcuts, but ImGui's text field samples keys once a frame, and a
+  // paused window's frames are short.
   void press(const std::string& keys) {
-    xdotool("keydown " + keys);
-    std::this_thread::sleep_for(std::chrono::milliseconds(500 * test::time_scale()));
-    xdotool("keyup " + keys);
+    std::vector<std::string> parts;
+    for (std::size_t start = 0;;) {
+      const std::size_t plus = keys.find('+', start);
+      parts.push_back(keys.substr(start, plus - start));
+      if (plus == std::string::npos) break;
+      start = plus + 1;
+    }
+    for (const auto& k : parts) xdotool("keydown " + k);
+    std::this_thread::sleep_for(400ms);
+    for (auto k = parts.rbegin(); k != parts.rend(); ++k) xdotool("keyup " + *k);
     std::this_thread::sleep_for(std::chrono::milliseconds(100 * test::time_scale()));
   }
 
@@ -303,9 +313,8 @@ TEST_F(OverlayWindow, PlaceSlideTurnShadowsSaveAndBadMeshes) {
   const auto not_a_mesh = scratch_.dir / "not_a_mesh.ply";
   std::ofstream(not_a_mesh) << "this is not a mesh\n";
   for (const std::string& path : {std::string("/nonexistent/figure.ply"), not_a_mesh.string()}) {
-    press("ctrl+o");
+    press("ctrl+o");  // focuses the mesh field with its text selected: typing replaces it
     pause_for_frames();
-    press("ctrl+a");
     xdotool("type --delay 30 '" + path + "'");
     press("Return");
     pause_for_frames();

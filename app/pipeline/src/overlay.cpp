@@ -147,7 +147,9 @@ OverlayFrame Overlay::composite(const capture::Frame& frame, const std::optional
   // each with its own context: draw in this one's.
   context_->make_current();
   play_paths(frame.time);
+  const auto measure_start = std::chrono::steady_clock::now();
   measure_camera(frame.image);
+  times_.measure += ms_since(measure_start);
   if (live_lighting_ && T_world_camera) {
     const auto t0 = std::chrono::steady_clock::now();
     out.lighting_scale = live_lighting_->update(compositor_->renderer(), frame.image, *T_world_camera, frame.time);
@@ -172,6 +174,7 @@ OverlayFrame Overlay::composite(const capture::Frame& frame, const std::optional
 std::vector<std::pair<std::string, double>> StageTimes::stages() const {
   return {{"decode video", decode},
           {"tracker pose", pose},
+          {"camera noise and blur", measure},
           {"lighting adaptation", lighting},
           {"shadows (moved objects)", shadows},
           {"upload frame", upload},

@@ -122,7 +122,7 @@ class OverlayUi {
         debug_.any() && pose_ ? draw_debug_views(image_, overlay_.compositor(), *pose_, debug_) : image_;
     window_.present_in_corner(shown, [&] {
       ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
-      if (window_shot_) {
+      if (window_shot_ && ImGui::GetFrameCount() > 2) {  // ImGui lays a new window out in its first frames
         window_shot_ = false;
         attempt("screenshot", [&] {
           calib::write_image_atomically(screenshot_path_, window_.read_back_buffer());
@@ -372,8 +372,8 @@ class OverlayUi {
     }
     if (scene.objects.empty()) ImGui::TextDisabled("no objects: add one below");
     if (focus_mesh_field_) ImGui::SetKeyboardFocusHere(), focus_mesh_field_ = false;
-    const bool entered =
-        ImGui::InputText("mesh", add_path_.data(), add_path_.size(), ImGuiInputTextFlags_EnterReturnsTrue);
+    const bool entered = ImGui::InputText("mesh", add_path_.data(), add_path_.size(),
+                                          ImGuiInputTextFlags_EnterReturnsTrue | ImGuiInputTextFlags_AutoSelectAll);
     ImGui::SameLine();
     if (ImGui::Button("Add") || entered) add_object();
     if (scene.objects.empty()) return;

@@ -42,7 +42,7 @@ struct OverlaySettings {
 };
 
 struct StageTimes {  // milliseconds, summed over frames
-  double decode = 0, pose = 0, lighting = 0, shadows = 0, upload = 0, background = 0, depth = 0, objects = 0,
+  double decode = 0, pose = 0, measure = 0, lighting = 0, shadows = 0, upload = 0, background = 0, depth = 0, objects = 0,
          antialiasing = 0, blur = 0, readback = 0, output = 0;
   // From a frame's start (replay: its decode; live: the middle of its exposure) to its
   // composite handed on, summed over frames.
