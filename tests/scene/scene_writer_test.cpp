@@ -15,17 +15,8 @@
 namespace lumar {
 namespace {
 
-class SceneWriter : public ::testing::Test {
- protected:
-  void SetUp() override { dir_ = test::scratch_dir("scene-writer"); }
-  void TearDown() override {
-    std::error_code ignored;
-    std::filesystem::remove_all(dir_, ignored);
-  }
-  std::filesystem::path dir_;
-};
-
-TEST_F(SceneWriter, EditedObjectsReadBackAtTheSameMatrices) {
+TEST(SceneWriter, EditedObjectsReadBackAtTheSameMatrices) {
+  const test::Scratch scratch("scene-writer");
   Scene scene = load_scene(test::source_dir() / "data/scenes/room/walk.json");
   const LoadedScene loaded = load_scene_files(scene);
   ASSERT_EQ(scene.objects.size(), 2u);
@@ -44,8 +35,8 @@ TEST_F(SceneWriter, EditedObjectsReadBackAtTheSameMatrices) {
   scene.objects.push_back(added);
   scene.objects[0].T_world_model = loaded.objects[0].T_world_model;
 
-  std::filesystem::create_directories(dir_ / "elsewhere");
-  const auto out = dir_ / "elsewhere/edited.json";
+  std::filesystem::create_directories(scratch.dir / "elsewhere");
+  const auto out = scratch.dir / "elsewhere/edited.json";
   save_scene(scene, out);
   const LoadedScene back = load_scene_files(out);
   ASSERT_EQ(back.objects.size(), 3u);
@@ -69,11 +60,12 @@ TEST_F(SceneWriter, EditedObjectsReadBackAtTheSameMatrices) {
   EXPECT_EQ(back.manifest.movement_max, scene.movement_max);
 }
 
-TEST_F(SceneWriter, AMissingSourceManifestIsAnInputErrorAndNothingIsWritten) {
+TEST(SceneWriter, AMissingSourceManifestIsAnInputErrorAndNothingIsWritten) {
+  const test::Scratch scratch("scene-writer");
   Scene scene = load_scene(test::source_dir() / "data/scenes/room/scene.json");
-  scene.manifest = dir_ / "gone.json";
-  EXPECT_THROW(save_scene(scene, dir_ / "out.json"), InputError);
-  EXPECT_FALSE(std::filesystem::exists(dir_ / "out.json"));
+  scene.manifest = scratch.dir / "gone.json";
+  EXPECT_THROW(save_scene(scene, scratch.dir / "out.json"), InputError);
+  EXPECT_FALSE(std::filesystem::exists(scratch.dir / "out.json"));
 }
 
 }  // namespace
