@@ -1,5 +1,6 @@
 // lumar shadows: how much the scene's virtual objects (in their manifest poses) darken
-// given points on real surfaces: E_with / E_without per RGB channel (docs/shadows.md).
+// given points on real surfaces: E_with / E_without per RGB channel, or with --bounce
+// (E_with + E_bounce) / E_without, the light they reflect included (docs/shadows.md).
 #include <spdlog/spdlog.h>
 #include <cmath>
 #include <fstream>
@@ -19,6 +20,8 @@ namespace {
 
 struct ShadowsOptions {
   std::string scene, query, out, method = "lines";
+  bool bounce = false;
+  int bounce_clusters = BounceSettings{}.samples;
 };
 
 void write_result(const std::filesystem::path& path, const std::vector<glm::vec3>& attenuation) {
@@ -42,18 +45,30 @@ void register_shadows(CLI::App& app) {
   cmd->add_option("--out", o->out, "CSV to write: a header and r,g,b = E_with / E_without per point")->required();
   cmd->add_option("--method", o->method, "lines (default), reference (brute force) or sphere (the 2004 method)")
       ->capture_default_str();
+  cmd->add_flag(
+      "--bounce", o->bounce,
+      "Add the light the objects reflect onto the points: (E_with + E_bounce) / E_without, which may exceed 1 "
+      "(lines or reference)");
+  cmd->add_option("--bounce-clusters", o->bounce_clusters, "lines --bounce: surface clusters per object")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 100000));
   add_action(cmd, [o] {
     const ShadowMethod method = parse_shadow_method(o->method);
+    if (o->bounce && method == ShadowMethod::Sphere)
+      throw InputError("--bounce: the sphere method (2004) has no bounce; use lines or reference");
     LoadedScene scene = load_scene_files(std::filesystem::path(o->scene));
     refuse_output_over_input(o->out, {o->query, o->scene});
     const QueryPoints q = read_query_points(o->query);
     const std::vector<glm::vec3> positions(q.points.begin(), q.points.end()),
         normals(q.normals.begin(), q.normals.end());
     const ShadowScene shadows(std::move(scene));
-    const auto attenuation = shadow_attenuation(shadows, positions, normals, method);
+    ShadowMethodOptions options;
+    options.bounce = o->bounce;
+    options.bounce_settings.samples = o->bounce_clusters;
+    const auto attenuation = shadow_attenuation(shadows, positions, normals, method, options);
     write_result(o->out, attenuation);
-    spdlog::info("shadows ({}): {} points, {} occluder(s) -> {}", o->method, positions.size(), shadows.objects().size(),
-                 o->out);
+    spdlog::info("shadows ({}{}): {} points, {} occluder(s) -> {}", o->method, o->bounce ? ", with bounce" : "",
+                 positions.size(), shadows.objects().size(), o->out);
   });
 }
 

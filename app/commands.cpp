@@ -17,7 +17,7 @@ void add_action(CLI::App* sub, std::function<void()> run) { actions()[sub] = std
 void add_composite_feature_options(CLI::App* cmd, std::string& without, double& blur_sigma_px) {
   cmd->add_option("--without", without,
                   "Switch off what makes the objects look like the camera's pixels: a comma-separated list of "
-                  "antialiasing, self-occlusion, noise, blur, or all (docs/ground_truth.md)");
+                  "antialiasing, self-occlusion, noise, blur, bounce, or all (docs/ground_truth.md)");
   cmd->add_option("--blur-sigma", blur_sigma_px,
                   "The camera's blur as a Gaussian of this many output pixels (default: estimated from the video)")
       ->check(CLI::Range(0.0, 4.0));
@@ -35,11 +35,13 @@ void apply_composite_features(const std::string& without, double blur_sigma_px, 
       f.noise = false;
     else if (name == "blur")
       f.blur = false;
+    else if (name == "bounce")
+      f.bounce = false;
     else if (name == "all")
-      f = gl::CompositeFeatures{false, false, false, false};
+      f = gl::CompositeFeatures{false, false, false, false, false};
     else
       throw InputError("--without " + without + ": unknown feature '" + name +
-                       "'; use antialiasing, self-occlusion, noise, blur or all");
+                       "'; use antialiasing, self-occlusion, noise, blur, bounce or all");
   }
   if (blur_sigma_px >= 0) settings.blur_sigma_px = blur_sigma_px;
 }

@@ -74,6 +74,73 @@ PY
   check_csv a.csv "min(min(r) for r in a) < 0.995"  # some points are shadowed, so the test can fail
 }
 
+case_bounce_adds_the_objects_light() {
+  # A white sphere on a plane under a uniform sky leaves the plane unchanged: it blocks F
+  # of the sky and sends F back (1 - (1 - albedo) F); lines and reference agree with that,
+  # and a black one leaves the shadow alone. The 2004 method has no bounce: refused.
+  python3 - "$TMP" <<'PY'
+import json, math, os, struct, sys
+tmp = sys.argv[1]
+# A uniform sky as a Radiance HDR (RGBE, flat scanlines), 64 x 32, radiance 1.
+w, h = 64, 32
+with open(os.path.join(tmp, "sky.hdr"), "wb") as f:
+    f.write(b"#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y %d +X %d\n" % (h, w))
+    f.write(bytes([128, 128, 128, 129]) * (w * h))
+# A UV sphere of radius 0.5 with its vertex normals.
+rows = ["ply", "format ascii 1.0"]
+verts, faces, n_lat, n_lon = [], [], 32, 64
+for i in range(n_lat + 1):
+    t = math.pi * i / n_lat
+    for j in range(n_lon):
+        p = 2 * math.pi * j / n_lon
+        verts.append((math.sin(t) * math.cos(p), math.cos(t), math.sin(t) * math.sin(p)))
+for i in range(n_lat):
+    for j in range(n_lon):
+        a, b = i * n_lon + j, i * n_lon + (j + 1) % n_lon
+        c, d = a + n_lon, b + n_lon
+        faces += [(a, c, d), (a, d, b)]
+rows += ["element vertex %d" % len(verts), "property float x", "property float y", "property float z",
+         "property float nx", "property float ny", "property float nz",
+         "element face %d" % len(faces), "property list uchar int vertex_indices", "end_header"]
+rows += ["%f %f %f %f %f %f" % (0.5 * x, 0.5 * y, 0.5 * z, x, y, z) for x, y, z in verts]
+rows += ["3 %d %d %d" % f for f in faces]
+open(os.path.join(tmp, "sphere.ply"), "w").write("\n".join(rows) + "\n")
+# A floor 12 m wide.
+open(os.path.join(tmp, "floor.obj"), "w").write(
+    "v -6 0 -6\nv 6 0 -6\nv 6 0 6\nv -6 0 6\nf 1 3 2\nf 1 4 3\n")
+for albedo in (1.0, 0.0):
+    scene = {"format": "lumar-scene", "version": 1, "room": {"mesh": "floor.obj"},
+             "environment_map": {"path": "sky.hdr", "capture_position": [0, 1, 0], "distant": True},
+             "movement_box": {"min": [-1, 0, -1], "max": [1, 1, 1]},
+             "objects": [{"name": "sphere", "mesh": "sphere.ply", "albedo": [albedo] * 3,
+                          "pose": {"translation": [0, 0.5, 0]}}]}
+    json.dump(scene, open(os.path.join(tmp, "sphere-%g.json" % albedo), "w"))
+rows = ["x,y,z,nx,ny,nz"] + ["%g,0,0,0,1,0" % (0.5 * x) for x in (0.3, 0.6, 1.0, 1.5, 2.5)]
+open(os.path.join(tmp, "in.csv"), "w").write("\n".join(rows) + "\n")
+PY
+  local albedo m
+  for albedo in 1 0; do
+    for m in lines reference; do
+      XDG_CACHE_HOME="$TMP/cache" "$LUMAR" shadows --scene "$TMP/sphere-$albedo.json" --query "$TMP/in.csv" \
+        --out "$TMP/$m-$albedo.csv" --method $m --bounce 2>"$TMP/stderr" ||
+        { cat "$TMP/stderr" >&2; fail "shadows --method $m --bounce failed"; }
+    done
+  done
+  python3 - "$TMP" <<'PY' || fail "the sphere's bounce is not 1 - (1 - albedo) F"
+import csv, sys
+xs = (0.3, 0.6, 1.0, 1.5, 2.5)
+for albedo in (1, 0):
+    for m in ("lines", "reference"):
+        rows = [tuple(map(float, r)) for r in list(csv.reader(open("%s/%s-%d.csv" % (sys.argv[1], m, albedo))))[1:]]
+        for x, r in zip(xs, rows):
+            expected = 1 - (1 - albedo) * (1 / (x * x + 1)) ** 1.5
+            assert abs(r[1] - expected) < 0.03, (m, albedo, x, r, expected)
+        print("ok: %s, albedo %d: %s" % (m, albedo, " ".join("%.3f" % r[1] for r in rows)))
+PY
+  expect_bad_input "no bounce" "$TMP/sphere.csv" -- \
+    "$LUMAR" shadows --scene "$TMP/sphere-1.json" --query "$TMP/in.csv" --out "$TMP/sphere.csv" --method sphere --bounce
+}
+
 case_bad_input() {
   write_query
   expect_bad_input "nope.csv" "$TMP/o1.csv" -- "$LUMAR" shadows --scene "$SCENE" --query "$TMP/nope.csv" --out "$TMP/o1.csv"

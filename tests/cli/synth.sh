@@ -83,6 +83,29 @@ PY
     "$LUMAR" synth --scene "$TMP/empty.json" --camera "$CAM" --out "$TMP/empty" --frames 2 --truth
 }
 
+case_bounce_lowers_the_shadow_error() {
+  # A saturated red box beside the figurine (data/scenes/room/red_box.json): the truth
+  # carries the light it reflects onto the floor, so the composite's shadow region is
+  # closer to it with bounce than without, in the same run of the same recording; and
+  # `--without all` (the 2004 look) switches bounce off too.
+  "$LUMAR" synth --scene "$SRC/data/scenes/room/red_box.json" --camera "$CAM" --out "$TMP/rec" --frames 2 \
+    --supersample 1 --truth >"$TMP/log" 2>&1 || { cat "$TMP/log"; fail "synth --truth failed"; }
+  "$LUMAR" regress --update "$TMP/rec" >"$TMP/log" 2>&1 || { cat "$TMP/log"; fail "regress --update failed"; }
+  "$LUMAR" regress --json "$TMP/rec" >"$TMP/with.json" 2>"$TMP/err" || { cat "$TMP/err"; fail "regress failed"; }
+  "$LUMAR" regress --json --without bounce "$TMP/rec" >"$TMP/without.json" 2>"$TMP/err" ||
+    { cat "$TMP/err"; fail "regress --without bounce failed"; }
+  python3 - "$TMP/with.json" "$TMP/without.json" <<'PY' || fail "bounce does not bring the shadow region closer to the truth"
+import json, sys
+a, b = (json.load(open(f)) for f in sys.argv[1:3])
+print("ok: shadow_err %.3f %% with bounce, %.3f %% without, noise floor %.3f %%; --without all %.3f %%"
+      % (a["shadow_err"], b["shadow_err"], a["noise_floor_shadow_err"], a["all_off_shadow_err"]))
+assert a["shadow_err"] < b["shadow_err"] - 0.05, (a["shadow_err"], b["shadow_err"])
+# All off has no bounce: its shadow error is the one without bounce (and the other
+# features barely touch the room's pixels).
+assert abs(a["all_off_shadow_err"] - b["shadow_err"]) < 0.1, (a["all_off_shadow_err"], b["shadow_err"])
+PY
+}
+
 case_synth_refuses_existing_output() {
   mkdir -p "$TMP/rec"
   touch "$TMP/rec/keep-me"

@@ -26,29 +26,35 @@ Mesh make_sphere(const glm::vec3& centre, float radius, int slices, int stacks) 
   return m;
 }
 
-Mesh make_box(const glm::vec3& lo, const glm::vec3& hi, bool inward) {
+Mesh make_box(const glm::vec3& lo, const glm::vec3& hi, bool inward, int cells) {
   Mesh m;
-  // Each face: outward normal axis/sign, four corners.
+  // Each face: outward normal axis/sign, a (cells + 1)² grid of corners.
   for (int axis = 0; axis < 3; ++axis)
     for (int side = 0; side < 2; ++side) {
       const int u = (axis + 1) % 3, v = (axis + 2) % 3;
       glm::vec3 n(0.0f);
       n[axis] = side ? 1.0f : -1.0f;
       const std::uint32_t base = std::uint32_t(m.positions.size());
-      for (int k = 0; k < 4; ++k) {
-        glm::vec3 p;
-        p[axis] = side ? hi[axis] : lo[axis];
-        p[u] = (k == 1 || k == 2) ? hi[u] : lo[u];
-        p[v] = (k >= 2) ? hi[v] : lo[v];
-        m.positions.push_back(p);
-        m.normals.push_back(inward ? -n : n);
-      }
-      // Corners 0-1-2-3 run counter-clockwise seen from +axis; reverse them where the
-      // front (the side the normal points to) faces the other way.
-      if ((side == 1) != inward)
-        m.indices.insert(m.indices.end(), {base, base + 1, base + 2, base, base + 2, base + 3});
-      else
-        m.indices.insert(m.indices.end(), {base, base + 2, base + 1, base, base + 3, base + 2});
+      for (int i = 0; i <= cells; ++i)
+        for (int j = 0; j <= cells; ++j) {
+          glm::vec3 p;
+          p[axis] = side ? hi[axis] : lo[axis];
+          p[u] = lo[u] + (hi[u] - lo[u]) * float(i) / float(cells);
+          p[v] = lo[v] + (hi[v] - lo[v]) * float(j) / float(cells);
+          m.positions.push_back(p);
+          m.normals.push_back(inward ? -n : n);
+        }
+      const auto at = [&](int i, int j) { return base + std::uint32_t(i * (cells + 1) + j); };
+      for (int i = 0; i < cells; ++i)
+        for (int j = 0; j < cells; ++j) {
+          // Corners a-b-c-d run counter-clockwise seen from +axis; reverse them where the
+          // front (the side the normal points to) faces the other way.
+          const std::uint32_t a = at(i, j), b = at(i + 1, j), c = at(i + 1, j + 1), d = at(i, j + 1);
+          if ((side == 1) != inward)
+            m.indices.insert(m.indices.end(), {a, b, c, a, c, d});
+          else
+            m.indices.insert(m.indices.end(), {a, c, b, a, d, c});
+        }
     }
   return m;
 }

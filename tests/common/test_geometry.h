@@ -9,8 +9,9 @@ namespace lumar::test {
 
 // Closed UV sphere with outward unit normals.
 Mesh make_sphere(const glm::vec3& centre, float radius, int slices, int stacks);
-// Axis-aligned box, 12 triangles, flat face normals pointing outward (inward if `inward`).
-Mesh make_box(const glm::vec3& min, const glm::vec3& max, bool inward = false);
+// Axis-aligned box, flat face normals pointing outward (inward if `inward`), each face a
+// cells x cells grid (12 triangles for 1).
+Mesh make_box(const glm::vec3& min, const glm::vec3& max, bool inward = false, int cells = 1);
 // A rectangle through `centre` spanned by half-extents `a` and `b`; all four vertex
 // normals are `normal` (need not match the geometry: the shading tests choose it freely).
 Mesh make_quad(const glm::vec3& centre, const glm::vec3& a, const glm::vec3& b, const glm::vec3& normal);

@@ -66,7 +66,7 @@ class SceneManifest : public ::testing::Test {
   "objects": [{"name": "figurine", "mesh": "figurine.ply", "albedo": [0.8, 0.7, 0.6],
                "pose": {"translation": [0.5, 0.25, -0.75], "rotation_axis": [0, 2, 0], "rotation_deg": 30,
                         "scale": 0.001, "model_origin": [60, -60, -634]}},
-              {"name": "plain", "mesh": "figurine.ply"}],
+              {"name": "plain", "mesh": "figurine.ply", "bounce": false}],
   "lighting": {"method": "sh9", "irradiance": {"spacing": 0.25, "rays_per_probe": 256, "refine": false}}
 })";
 
@@ -95,6 +95,7 @@ TEST_F(SceneManifest, ValidManifestParses) {
   EXPECT_EQ(fig.name, "figurine");
   EXPECT_EQ(fig.mesh, dir_ / "figurine.ply");
   EXPECT_EQ(fig.albedo, glm::vec3(0.8f, 0.7f, 0.6f));
+  EXPECT_TRUE(fig.bounce);  // the default
   const glm::dvec3 origin(60, -60, -634), translation(0.5, 0.25, -0.75);
   const auto apply = [&](const glm::dvec3& p) { return glm::dvec3(fig.T_world_model * glm::dvec4(p, 1.0)); };
   EXPECT_NEAR(glm::distance(apply(origin), translation), 0.0, 1e-12) << "model_origin lands at translation";
@@ -107,6 +108,7 @@ TEST_F(SceneManifest, ValidManifestParses) {
   const SceneObject& plain = scene.objects[1];
   EXPECT_EQ(plain.albedo, glm::vec3(0.8f));
   EXPECT_EQ(plain.T_world_model, glm::dmat4(1.0));
+  EXPECT_FALSE(plain.bounce);
 }
 
 TEST_F(SceneManifest, DistantMapNeedsNoRoomAndDefaultsApply) {
@@ -160,6 +162,11 @@ TEST_F(SceneManifest, BadAlbedo) {
   expect_error(write_changed("[0.8, 0.7, 0.6]", "[0.8, 0.7]"), "objects[0].albedo");
   expect_error(write_changed("[0.8, 0.7, 0.6]", "\"grey\""), "objects[0].albedo");
   expect_error(write_changed("[0.8, 0.7, 0.6]", "[0.8, -0.1, 0.6]"), "objects[0].albedo");
+}
+
+TEST_F(SceneManifest, BadBounce) {
+  expect_error(write_changed(R"("bounce": false)", R"("bounce": "no")"), "objects[1].bounce", "expected true or false");
+  expect_error(write_changed(R"("bounce": false)", R"("bounce": 0)"), "objects[1].bounce");
 }
 
 TEST_F(SceneManifest, MissingReferencedFilesAreNamed) {

@@ -29,6 +29,7 @@ TEST(SceneWriter, EditedObjectsReadBackAtTheSameMatrices) {
                         glm::rotate(glm::dmat4(1.0), 0.7, glm::dvec3(0, 1, 0)) *
                         glm::scale(glm::dmat4(1.0), glm::dvec3(1.1)) * glm::translate(glm::dmat4(1.0), -foot) * T;
   still.albedo = glm::vec3(0.1f, 0.5f, 0.25f);
+  still.bounce = false;
   SceneObject added = still;
   added.name = "added";
   added.T_world_model = glm::translate(glm::dmat4(1.0), glm::dvec3(-0.5, 0.0, 0.5)) * loaded.objects[1].T_world_model;
@@ -45,7 +46,10 @@ TEST(SceneWriter, EditedObjectsReadBackAtTheSameMatrices) {
       for (int r = 0; r < 4; ++r)
         EXPECT_NEAR(back.objects[i].T_world_model[c][r], scene.objects[i].T_world_model[c][r], 1e-12) << i;
   EXPECT_EQ(back.objects[1].albedo, scene.objects[1].albedo);  // `still` dangles after the push_back
+  EXPECT_FALSE(back.objects[1].bounce);
+  EXPECT_TRUE(back.objects[0].bounce);
   EXPECT_EQ(back.objects[2].name, "added");
+  EXPECT_FALSE(back.objects[2].bounce);
   // The walker keeps its path: the same poses along it.
   ASSERT_FALSE(back.objects[0].path.empty());
   for (double t : {0.0, 0.7, 1.9, 5.0})

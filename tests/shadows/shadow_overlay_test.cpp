@@ -13,6 +13,7 @@
 
 #include "lumar/base/color.h"
 #include "lumar/base/error.h"
+#include "lumar/lighting/shadows/object_bounce.h"
 #include "lumar/lighting/shadows/object_shadows.h"
 #include "lumar/lighting/shadows/shadow_occlusion.h"
 #include "lumar/render/compositor.h"
@@ -156,6 +157,95 @@ TEST(ShadowOverlay, VideoDarkensWhereTheLinesSayAndNowhereElse) {
       unexplained += !near_shadow;
     }
   std::printf("%d pixels darkened, %d of them away from a predicted shadow\n", changed, unexplained);
+  EXPECT_GT(changed, 100);
+  EXPECT_EQ(unexplained, 0);
+}
+
+// A saturated red box beside the figurine: with bounce on, the floor around it turns
+// redder by what ObjectBounce says at each receiver vertex ((E_with + E_bounce) / E_with
+// against the same frame with bounce off), brighter in red than without the box's
+// shadow, and nothing else changes.
+TEST(ShadowOverlay, ARedBoxTintsTheFloorBesideIt) {
+  auto [camera, pose, scene] = sample_view();
+  LoadedObject box;
+  box.name = "red box";
+  box.model = load_mesh(test::source_dir() / "data/models/box.obj");
+  box.T_world_model = glm::translate(glm::dmat4(1.0), glm::dvec3(0.3, 0.0, 0.05));
+  box.albedo = {0.9f, 0.05f, 0.05f};
+  scene.objects.push_back(box);
+  Compositor compositor(std::make_shared<const LoadedScene>(scene), camera, cv::Mat(), cv::Mat());
+  ASSERT_NE(compositor.bounce(), nullptr);
+  const double exposure = 0.66;
+  const cv::Mat video = room_video(compositor, camera, pose, exposure);
+  gl::CompositeFeatures features;
+  features.noise = false;  // the same pixels but for the bounce
+  compositor.set_features(features);
+  const cv::Mat on = compositor.composite(video, pose, exposure);
+  features.bounce = false;
+  compositor.set_features(features);
+  const cv::Mat off = compositor.composite(video, pose, exposure);
+  const auto out_dir = test::scratch_dir("bounce_overlay");
+  cv::imwrite((out_dir / "on.png").string(), on);
+  cv::imwrite((out_dir / "off.png").string(), off);
+  const cv::Mat lin_on = linear(on), lin_off = linear(off);
+  const cv::Mat object_mask = compositor.renderer().render_object_mask(pose);
+
+  const auto& origins = compositor.shadows()->lines().origins;
+  const auto& att = compositor.shadows()->attenuation();
+  const auto& bounce = compositor.bounce()->ratio();
+  const glm::dmat4 T_camera_world = pose.inverse().matrix();
+  int checked = 0, brighter = 0, redder = 0;
+  double worst = 0;
+  for (std::size_t i = 0; i < origins.size(); ++i) {
+    if (bounce[i].r < 0.02f) continue;
+    const glm::dvec3 pc = glm::dvec3(T_camera_world * glm::dvec4(glm::dvec3(origins[i]), 1.0));
+    if (pc.z <= 0.1) continue;
+    const glm::dvec2 uv = project_pinhole(camera, pc);
+    const int u = int(std::lround(uv.x)), v = int(std::lround(uv.y));
+    if (u < 2 || v < 2 || u >= camera.width - 2 || v >= camera.height - 2) continue;
+    bool near_object = false;
+    for (int dv = -2; dv <= 2; ++dv)
+      for (int du = -2; du <= 2; ++du) near_object |= object_mask.at<uchar>(v + dv, u + du) != 0;
+    if (near_object) continue;
+    const float base = lin_off.at<cv::Vec3f>(v, u)[2];  // BGR: red
+    if (base < 0.02f || lin_on.at<cv::Vec3f>(v, u)[2] > 0.98f) continue;
+    const double expected = (att[i].r + bounce[i].r) / att[i].r;
+    const double ratio = lin_on.at<cv::Vec3f>(v, u)[2] / base;
+    worst = std::max(worst, std::abs(ratio / expected - 1.0));
+    EXPECT_NEAR(ratio / expected, 1.0, 0.06) << "vertex " << i << " at pixel " << u << "," << v;
+    // Green by its own (small) bounce: the box reflects little of it.
+    const double expected_green = (att[i].g + bounce[i].g) / att[i].g;
+    EXPECT_NEAR(lin_on.at<cv::Vec3f>(v, u)[1] / lin_off.at<cv::Vec3f>(v, u)[1] / expected_green, 1.0, 0.06);
+    redder += expected > expected_green;
+    brighter += att[i].r + bounce[i].r > 1.0f;
+    ++checked;
+  }
+  std::printf("checked %d floor vertices the box lights, %d brighter than without the box; worst ratio error %.3f\n",
+              checked, brighter, worst);
+  EXPECT_GE(checked, 10);
+  EXPECT_GE(brighter, 1);
+  EXPECT_EQ(redder, checked);
+
+  // Nowhere else: a pixel that changed sees the floor near a receiver the box lights.
+  const glm::dvec3 eye = pose.translation;
+  int changed = 0, unexplained = 0;
+  for (int v = 0; v < on.rows; ++v)
+    for (int u = 0; u < on.cols; ++u) {
+      const cv::Vec3b a = on.at<cv::Vec3b>(v, u), b = off.at<cv::Vec3b>(v, u);
+      if (std::abs(int(a[2]) - int(b[2])) <= 1) continue;
+      ++changed;
+      EXPECT_GT(int(a[2]), int(b[2])) << "bounce only adds light";
+      const glm::dvec3 ray =
+          pose.rotation_matrix() * glm::dvec3((u - camera.cx) / camera.fx, (v - camera.cy) / camera.fy, 1.0);
+      bool near_bounce = false;
+      if (ray.y < 0) {
+        const glm::dvec3 p = eye + (-eye.y / ray.y) * ray;
+        for (std::size_t i = 0; i < origins.size() && !near_bounce; ++i)
+          near_bounce = bounce[i].r > 0.002f && glm::length(glm::dvec3(origins[i]) - p) < 0.1;
+      }
+      unexplained += !near_bounce;
+    }
+  std::printf("%d pixels redder, %d of them away from the box's light\n", changed, unexplained);
   EXPECT_GT(changed, 100);
   EXPECT_EQ(unexplained, 0);
 }

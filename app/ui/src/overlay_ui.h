@@ -380,6 +380,8 @@ class OverlayUi {
     const std::size_t i = selected();
     glm::vec3 albedo = scene.objects[i].albedo;
     if (ImGui::ColorEdit3("albedo", &albedo.x)) editor_.set_albedo(i, albedo), dirty_ = true;
+    bool bounce = scene.objects[i].bounce;
+    if (ImGui::Checkbox("lights the room (bounce)", &bounce)) editor_.set_bounce(i, bounce), dirty_ = true;
     float scale = float(editor_.scale_factor(i));
     if (ImGui::SliderFloat("scale", &scale, 0.2f, 5.0f, "%.2fx", ImGuiSliderFlags_Logarithmic))
       editor_.set_scale_factor(i, scale), dirty_ = true;
@@ -416,6 +418,7 @@ class OverlayUi {
     dirty_ |= ImGui::Checkbox("noise", &features_.noise);
     ImGui::SameLine();
     dirty_ |= ImGui::Checkbox("blur", &features_.blur);
+    dirty_ |= ImGui::Checkbox("bounce (objects light the room)", &features_.bounce);
     float exposure = float(overlay_.exposure_scale());
     if (ImGui::SliderFloat("exposure", &exposure, 0.25f, 4.0f, "%.2fx", ImGuiSliderFlags_Logarithmic))
       overlay_.set_exposure_scale(exposure), dirty_ = true;

@@ -68,10 +68,16 @@ void SceneEditor::set_scale_factor(std::size_t i, double factor) {
   set_pose(i, rest_on_surface(o.model, linear, rests_[i]), rests_[i]);
 }
 
+void SceneEditor::set_bounce(std::size_t i, bool on) {
+  scene_.objects.at(i).bounce = on;
+  scene_.manifest.objects[i].bounce = on;
+  overlay_.compositor().set_object_bounce(i, on);
+}
+
 void SceneEditor::set_albedo(std::size_t i, const glm::vec3& albedo) {
   scene_.objects.at(i).albedo = albedo;
   scene_.manifest.objects[i].albedo = albedo;
-  overlay_.compositor().renderer().set_object_material(int(i), albedo, overlay_.compositor().lighting_sh());
+  overlay_.compositor().set_object_albedo(i, albedo);
 }
 
 std::size_t SceneEditor::add(const std::filesystem::path& mesh_path, const SurfacePoint& at) {
@@ -95,7 +101,7 @@ std::size_t SceneEditor::add(const std::filesystem::path& mesh_path, const Surfa
   entry.T_world_model = T;
   entry.albedo = glm::vec3(0.7f);
   scene_.manifest.objects.push_back(entry);
-  scene_.objects.push_back(LoadedObject{name, std::move(mesh), T, entry.albedo, {}});
+  scene_.objects.push_back(LoadedObject{name, std::move(mesh), T, entry.albedo, {}, entry.bounce});
   rests_.push_back(at);
   scale_factors_.push_back(1.0);
   rebuild();

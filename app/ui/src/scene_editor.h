@@ -38,6 +38,8 @@ class SceneEditor {
   // Scales it about its footprint, `factor` times its size when it was loaded or added.
   void set_scale_factor(std::size_t i, double factor);
   void set_albedo(std::size_t i, const glm::vec3& albedo);
+  // Whether object i reflects light onto the room (the manifest's "bounce").
+  void set_bounce(std::size_t i, bool on);
   // Loads a mesh (InputError when it does not load) and rests it at `at`, its bounding
   // box's diagonal 0.4 m; returns its index.
   std::size_t add(const std::filesystem::path& mesh, const SurfacePoint& at);

@@ -8,6 +8,7 @@
 #include "lumar/lighting/irradiance_scene.h"
 #include "lumar/lighting/irradiance_volume.h"
 #include "lumar/lighting/self_occlusion.h"
+#include "lumar/lighting/shadows/object_bounce.h"
 #include "lumar/lighting/shadows/object_shadows.h"
 #include "lumar/lighting/shadows/shadow_methods.h"
 #include "lumar/lighting/shadows/shadow_occlusion.h"
@@ -57,18 +58,31 @@ void Compositor::pose_object_points() {
 }
 
 void Compositor::bake_self_occlusion_once() {
-  if (self_occlusion_baked_) return;
-  self_occlusion_baked_ = true;
+  if (!self_occlusion_.empty() || scene_->objects.empty()) return;
   const auto t0 = std::chrono::steady_clock::now();
-  for (std::size_t i = 0; i < scene_->objects.size(); ++i)
-    renderer_->set_object_self_occlusion(int(i), bake_self_occlusion(scene_->objects[i].model));
+  for (std::size_t i = 0; i < scene_->objects.size(); ++i) {
+    self_occlusion_.push_back(bake_self_occlusion(scene_->objects[i].model));
+    renderer_->set_object_self_occlusion(int(i), self_occlusion_.back());
+  }
   spdlog::debug("self-occlusion baked in {:.0f} ms",
                 std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
 }
 
+// The bounce shades the objects as the renderer does: with their self-occlusion when it is on.
+void Compositor::give_bounce_occlusion() {
+  if (!bounce_) return;
+  const bool on = renderer_->features().self_occlusion && !self_occlusion_.empty();
+  for (std::size_t i = 0; i < scene_->objects.size(); ++i)
+    bounce_->set_object_occlusion(
+        int(i), on ? std::span<const VertexOcclusion>(self_occlusion_[i]) : std::span<const VertexOcclusion>());
+}
+
 void Compositor::set_features(const gl::CompositeFeatures& features) {
   if (features.self_occlusion) bake_self_occlusion_once();
+  const gl::CompositeFeatures before = renderer_->features();
   renderer_->set_features(features);
+  if (before.self_occlusion != features.self_occlusion) give_bounce_occlusion();
+  if (before.bounce != features.bounce) shadows_uploaded_ = false;
 }
 
 // Precomputes the shadow lines from the scene's receivers to its emitters (the objects
@@ -96,6 +110,13 @@ void Compositor::build_shadows() {
         build_shadow_lines(receivers.positions, receivers.normals, emitters, shadow_scene.proxy()));
     for (std::size_t i = 0; i < objects.size(); ++i) shadows_->add_object(objects[i].model, poses_[i]);
     renderer_->set_receivers(receivers);
+    bounce_ =
+        std::make_shared<ObjectBounce>(shadows_->lines().origins, receivers.normals, shadows_->lines().unshadowed);
+    for (std::size_t i = 0; i < objects.size(); ++i) {
+      bounce_->add_object(objects[i].model, objects[i].albedo, poses_[i]);
+      bounce_->set_object_enabled(int(i), objects[i].bounce);
+    }
+    give_bounce_occlusion();
     spdlog::debug("shadows: {} receivers, {} emitter patches, {} lines", receivers.positions.size(),
                   emitters.patches.size(), shadows_->lines().lines.size());
   }
@@ -113,6 +134,7 @@ void Compositor::set_shadow_quality(const ShadowQuality& quality) {
   shadow_quality_ = quality;
   shadows_.reset();
   object_shadows_.reset();
+  bounce_.reset();
   build_shadows();
   shadows_uploaded_ = object_shadows_uploaded_ = false;
 }
@@ -124,6 +146,17 @@ void Compositor::set_object_pose(std::size_t index, const glm::dmat4& T_world_mo
   renderer_->set_object_pose(int(index), T_world_model);
   if (shadows_) shadows_->set_object_pose(int(index), T_world_model);
   if (object_shadows_) object_shadows_->set_object_pose(int(index), T_world_model);
+  if (bounce_) bounce_->set_object_pose(int(index), T_world_model);
+}
+
+void Compositor::set_object_bounce(std::size_t index, bool on) {
+  if (index >= poses_.size()) throw RuntimeError("compositor: no object " + std::to_string(index));
+  if (bounce_) bounce_->set_object_enabled(int(index), on);
+}
+
+void Compositor::set_object_albedo(std::size_t index, const glm::vec3& albedo) {
+  renderer_->set_object_material(int(index), albedo, sh_);
+  if (bounce_) bounce_->set_object_albedo(int(index), albedo);
 }
 
 void Compositor::set_shadows_enabled(bool on, bool on_each_other) {
@@ -146,9 +179,24 @@ void Compositor::set_shadows_enabled(bool on, bool on_each_other) {
 cv::Mat Compositor::composite(const cv::Mat& video_bgr8, const std::optional<Pose>& T_world_camera, double exposure,
                               gl::OverlayTimings* timings) {
   const auto t0 = std::chrono::steady_clock::now();
-  if (shadows_ && shadows_enabled_ && (shadows_->update() || !shadows_uploaded_)) {
-    renderer_->set_receiver_attenuation(shadows_->attenuation());
-    shadows_uploaded_ = true;
+  if (shadows_ && shadows_enabled_) {
+    const bool bounce = bounce_ && renderer_->features().bounce;
+    bool changed = shadows_->update();
+    if (bounce)
+      changed |= bounce_->update([this](const glm::vec3& p, const glm::vec3& n) {
+        return volume_ ? glm::vec3(volume_->evaluate(glm::dvec3(p), glm::dvec3(n)))
+                       : glm::vec3(sh9_irradiance(sh_, glm::dvec3(n)));
+      });
+    if (changed || !shadows_uploaded_) {
+      if (bounce) {
+        std::vector<glm::vec3> light = shadows_->attenuation();
+        for (std::size_t i = 0; i < light.size(); ++i) light[i] += bounce_->ratio()[i];
+        renderer_->set_receiver_attenuation(light);
+      } else {
+        renderer_->set_receiver_attenuation(shadows_->attenuation());
+      }
+      shadows_uploaded_ = true;
+    }
   }
   if (object_shadows_ && object_shadows_enabled_ && (object_shadows_->update() || !object_shadows_uploaded_)) {
     for (std::size_t i = 0; i < object_shadows_->object_count(); ++i)

@@ -22,12 +22,13 @@ void main() {
 }
 )glsl";
 
-// Blending multiplies: destination * source.
+// Blending multiplies: destination * source. Above 1 is the light the objects reflect
+// onto the receiver (the linear scene is a float target, so it is not clamped).
 const char* const kReceiverFragment = R"glsl(
 #version 450 core
 in vec3 vertex_attenuation;
 out vec4 color;
-void main() { color = vec4(clamp(vertex_attenuation, 0.0, 1.0), 1.0); }
+void main() { color = vec4(max(vertex_attenuation, 0.0), 1.0); }
 )glsl";
 
 }  // namespace

@@ -117,7 +117,7 @@ LoadedScene load_scene_files(const Scene& manifest) {
   out.objects.reserve(manifest.objects.size());  // the pointers above stay valid
   for (std::size_t i = 0; i < manifest.objects.size(); ++i) {
     const SceneObject& o = manifest.objects[i];
-    LoadedObject object{o.name, {}, o.T_world_model, o.albedo, {}};
+    LoadedObject object{o.name, {}, o.T_world_model, o.albedo, {}, o.bounce};
     if (const auto it = decoded.find(o.mesh); it != decoded.end())
       object.model = *it->second;
     else

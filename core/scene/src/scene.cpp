@@ -218,7 +218,7 @@ std::vector<PathKey> read_path(const ManifestReader& r, const json& v, const std
 
 SceneObject read_object(const ManifestReader& r, const json& v, const std::string& key) {
   if (!v.is_object()) r.fail(key, "expected an object");
-  r.only_keys(v, key, {"name", "mesh", "albedo", "pose", "path"});
+  r.only_keys(v, key, {"name", "mesh", "albedo", "bounce", "pose", "path"});
   SceneObject object;
   object.name = r.string(v, key, "name");
   object.mesh = r.existing_file(v, key, "mesh");
@@ -229,6 +229,7 @@ SceneObject read_object(const ManifestReader& r, const json& v, const std::strin
       if (a[i] < 0.0 || a[i] > 1.0) r.fail(key + ".albedo", what);
     object.albedo = glm::vec3(a);
   }
+  object.bounce = r.boolean_or(v, key, "bounce", true);
 
   if (v.contains("pose")) object.pose = read_pose(r, r.object(v, key, "pose"), key + ".pose");
   object.T_world_model = pose_matrix(object.pose);

@@ -55,6 +55,10 @@ void save_scene(const Scene& scene, const std::filesystem::path& out) {
     entry["name"] = o.name;
     entry["mesh"] = relative_to(o.mesh, folder);
     entry["albedo"] = vec(glm::dvec3(o.albedo));
+    if (o.bounce)
+      entry.erase("bounce");  // the default
+    else
+      entry["bounce"] = false;
     // An animated object keeps its source's pose and path: its keys are read against
     // that pose (its scale, origin and rotation).
     if (o.path.empty() || !entry.contains("path")) {

@@ -5,6 +5,10 @@
 #include <algorithm>
 
 #include "lumar/base/error.h"
+#include "lumar/lighting/composite_reference.h"
+#include "lumar/lighting/irradiance_scene.h"
+#include "lumar/lighting/self_occlusion.h"
+#include "lumar/lighting/sh.h"
 #include "lumar/lighting/shadows/shadow_occlusion.h"
 #include "lumar/lighting/shadows/shadow_receivers.h"
 
@@ -185,16 +189,54 @@ std::unique_ptr<RayScene> ShadowScene::occluders() const {
   return s;
 }
 
+namespace {
+
+// The ground truth with the objects' bounce (composite_reference.h), per point.
+std::vector<glm::vec3> reference_with_bounce(const ShadowScene& scene, const std::vector<glm::vec3>& positions,
+                                             const std::vector<glm::vec3>& normals) {
+  const std::unique_ptr<RoomRadiance> room = scene_radiance(scene.scene(), RadianceSettings{});
+  std::vector<LoadedObject> objects;
+  for (const LoadedObject& o : scene.objects())
+    if (o.bounce) objects.push_back(o);
+  // Objects that reflect nothing still block: albedo 0.
+  for (const LoadedObject& o : scene.objects())
+    if (!o.bounce) objects.push_back(o), objects.back().albedo = glm::vec3(0.0f);
+  const CompositeReference reference(*room, objects);
+  std::vector<glm::vec3> out(positions.size());
+  tbb::parallel_for(std::size_t(0), positions.size(), [&](std::size_t i) {
+    out[i] = glm::vec3(reference.room_ratio(glm::dvec3(positions[i]), glm::dvec3(normals[i])));
+  });
+  return out;
+}
+
+// What shades the objects, on the CPU: the scene's irradiance volume, or SH9.
+ObjectBounce::Irradiance scene_object_irradiance(const ShadowScene& scene, bool volume_cache,
+                                                 std::shared_ptr<const IrradianceVolume>& volume) {
+  const std::string& method = scene.scene().manifest.lighting.method;
+  if (method == "sh9") {
+    const SH9 sh = project_radiance_sh9(scene.map());
+    return [sh](const glm::vec3&, const glm::vec3& n) { return glm::vec3(sh9_irradiance(sh, glm::dvec3(n))); };
+  }
+  volume = std::make_shared<const IrradianceVolume>(scene_irradiance_volume(scene.scene(), method, volume_cache));
+  return [v = volume.get()](const glm::vec3& p, const glm::vec3& n) {
+    return glm::vec3(v->evaluate(glm::dvec3(p), glm::dvec3(n)));
+  };
+}
+
+}  // namespace
+
 std::vector<glm::vec3> shadow_attenuation(const ShadowScene& scene, const std::vector<glm::vec3>& positions,
                                           const std::vector<glm::vec3>& normals, ShadowMethod method,
                                           const ShadowMethodOptions& options) {
   check_points(positions, normals);
   switch (method) {
     case ShadowMethod::Reference: {
+      if (options.bounce) return reference_with_bounce(scene, positions, normals);
       const Emitters e = scene.emitters(positions, normals, options.emitters);
       return reference_attenuation(positions, normals, e, scene.proxy(), *scene.occluders());
     }
     case ShadowMethod::Sphere: {
+      if (options.bounce) throw InputError("--bounce: the sphere method (2004) has no bounce; use lines or reference");
       EmitterOptions eo = sphere_baseline_emitter_options();
       eo.map_width = options.emitters.map_width;
       const Emitters e = scene.emitters(positions, normals, eo);
@@ -208,7 +250,18 @@ std::vector<glm::vec3> shadow_attenuation(const ShadowScene& scene, const std::v
       LineShadows shadows(build_shadow_lines(positions, normals, e, scene.proxy(), options.lines));
       for (const auto& o : scene.objects()) shadows.add_object(o.model, o.T_world_model);
       shadows.update();
-      return shadows.attenuation();
+      if (!options.bounce) return shadows.attenuation();
+      ObjectBounce bounce(shadows.lines().origins, normals, shadows.lines().unshadowed, options.bounce_settings);
+      for (const auto& o : scene.objects()) {
+        const int id = bounce.add_object(o.model, o.albedo, o.T_world_model);
+        bounce.set_object_enabled(id, o.bounce);
+        if (o.bounce) bounce.set_object_occlusion(id, bake_self_occlusion(o.model));
+      }
+      std::shared_ptr<const IrradianceVolume> volume;
+      bounce.update(scene_object_irradiance(scene, options.volume_cache, volume));
+      std::vector<glm::vec3> out = shadows.attenuation();
+      for (std::size_t i = 0; i < out.size(); ++i) out[i] += bounce.ratio()[i];
+      return out;
     }
   }
 }

@@ -16,7 +16,9 @@ namespace lumar {
 
 class LineShadows;
 class ObjectShadows;
+class ObjectBounce;
 class IrradianceVolume;
+struct VertexOcclusion;
 
 // The shadows' quality knobs (docs/shadows.md): how many emitter patches the map is split
 // into, and how many sample points (line ends) each patch has, so lines per receiver and
@@ -46,6 +48,10 @@ class Compositor {
   // shadows are recomputed in the next composite() only if a pose changed.
   void set_object_pose(std::size_t index, const glm::dmat4& T_world_model);
   const glm::dmat4& object_pose(std::size_t index) const { return poses_.at(index); }
+  // The object's diffuse albedo: its shading and the light it reflects onto the room.
+  void set_object_albedo(std::size_t index, const glm::vec3& albedo);
+  // Whether the object reflects light onto the receivers (the manifest's "bounce").
+  void set_object_bounce(std::size_t index, bool on);
   // Soft shadows of the objects on the receivers and, with two objects or more, on each
   // other (docs/shadows.md); on by default. `on_each_other`: the latter alone.
   void set_shadows_enabled(bool on, bool on_each_other);
@@ -56,13 +62,17 @@ class Compositor {
   // the objects keep their current poses.
   void set_shadow_quality(const ShadowQuality& quality);
   const ShadowQuality& shadow_quality() const { return shadow_quality_; }
-  // Antialiasing, self-occlusion, noise and blur (gl::CompositeFeatures); all on by
-  // default. The objects' self-occlusion is baked the first time it is on.
+  // Antialiasing, self-occlusion, noise, blur and bounce (gl::CompositeFeatures); all on
+  // by default. The objects' self-occlusion is baked the first time it is on. Bounce is
+  // the light the objects reflect onto the receivers, added to their shadows
+  // (lighting/shadows/object_bounce.h), for objects whose manifest entry allows it.
   void set_features(const gl::CompositeFeatures& features);
   // The shadow lines, or nullptr when the scene has no receivers.
   const LineShadows* shadows() const { return shadows_.get(); }
   // The objects' shadows on each other, or nullptr with fewer than two objects.
   const ObjectShadows* object_shadows() const { return object_shadows_.get(); }
+  // The objects' light on the receivers, or nullptr when the scene has no receivers.
+  const ObjectBounce* bounce() const { return bounce_.get(); }
 
   gl::Renderer& renderer() { return *renderer_; }
   const LoadedScene& scene() const { return *scene_; }
@@ -83,13 +93,15 @@ class Compositor {
   std::shared_ptr<IrradianceVolume> volume_;  // shared_ptr: incomplete here
   void build_shadows();
   void bake_self_occlusion_once();
-  bool self_occlusion_baked_ = false;
-  std::vector<glm::dmat4> poses_;                        // T_world_model per object
-  std::vector<std::vector<glm::dvec3>> sampled_points_;  // per object, model coordinates
-  std::vector<glm::dvec3> object_points_;                // the above, posed
+  void give_bounce_occlusion();
+  std::vector<std::vector<VertexOcclusion>> self_occlusion_;  // per object, once baked
+  std::vector<glm::dmat4> poses_;                             // T_world_model per object
+  std::vector<std::vector<glm::dvec3>> sampled_points_;       // per object, model coordinates
+  std::vector<glm::dvec3> object_points_;                     // the above, posed
   void pose_object_points();
   std::shared_ptr<LineShadows> shadows_;  // shared_ptr: LineShadows is incomplete here
   std::shared_ptr<ObjectShadows> object_shadows_;
+  std::shared_ptr<ObjectBounce> bounce_;
   ShadowQuality shadow_quality_;
   bool shadows_enabled_ = true, object_shadows_enabled_ = true, shadows_uploaded_ = false,
        object_shadows_uploaded_ = false;

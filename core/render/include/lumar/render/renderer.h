@@ -60,6 +60,7 @@ struct CompositeFeatures {
   bool self_occlusion = true;  // the objects' baked occlusion of themselves
   bool noise = true;           // VideoRadiometry's noise on rendered pixels
   bool blur = true;            // VideoRadiometry's blur on rendered pixels and their edges
+  bool bounce = true;          // the objects' light reflected onto the receivers (the Compositor's)
 };
 
 class Renderer {

@@ -21,7 +21,8 @@ struct LoadedObject {
   Mesh model;                     // in the file's units
   glm::dmat4 T_world_model{1.0};  // its pose; an animated object's at its path's start
   glm::vec3 albedo{0.8f};
-  ObjectPath path;  // empty: it stands still
+  ObjectPath path;     // empty: it stands still
+  bool bounce = true;  // it reflects light onto the real surfaces
 
   // Where it stands t seconds into the recording.
   glm::dmat4 pose_at(double t_s) const { return path.empty() ? T_world_model : path.at(t_s); }

@@ -52,6 +52,7 @@ struct SceneObject {
   // and on_floor, which need the mesh.
   glm::dmat4 T_world_model{1.0};
   glm::vec3 albedo{0.8f};
+  bool bounce = true;  // it reflects light onto the real surfaces (docs/shadows.md, "Bounce")
 };
 
 // An axis-aligned world box (metres) marking a region of the proxy room.

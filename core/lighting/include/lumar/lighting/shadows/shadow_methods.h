@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "lumar/lighting/ray_scene.h"
+#include "lumar/lighting/shadows/object_bounce.h"
 #include "lumar/lighting/shadows/shadow_emitters.h"
 #include "lumar/lighting/shadows/shadow_lines.h"
 #include "lumar/scene/envmap.h"
@@ -83,9 +84,21 @@ class ShadowScene {
 struct ShadowMethodOptions {
   EmitterOptions emitters;
   ShadowLineOptions lines;
+  // Add the light the objects reflect onto the points (object_bounce.h; objects whose
+  // manifest says "bounce": false reflect nothing). lines: the attenuation plus
+  // ObjectBounce's ratio, the objects shaded by the scene's irradiance volume (or SH9)
+  // and their baked self-occlusion, as in the overlay; reference: the composite's ground
+  // truth (composite_reference.h, which integrates the room's radiance rather than the
+  // emitters); sphere: InputError (the 2004 method had no bounce).
+  bool bounce = false;
+  BounceSettings bounce_settings;
+  // Where the irradiance volume is cached (empty: the default); false: always built.
+  bool volume_cache = true;
 };
 
-// Attenuation of each point (unit normals) by the scene's objects in their poses.
+// Attenuation of each point (unit normals) by the scene's objects in their poses:
+// E_with / E_without per channel in [0, 1]; with bounce, (E_with + E_bounce) / E_without,
+// which may exceed 1.
 std::vector<glm::vec3> shadow_attenuation(const ShadowScene& scene, const std::vector<glm::vec3>& positions,
                                           const std::vector<glm::vec3>& normals, ShadowMethod method,
                                           const ShadowMethodOptions& options = {});
