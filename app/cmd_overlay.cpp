@@ -64,11 +64,16 @@ ui::OverlayWindowSettings window_settings(const OverlayOptions& o, const pipelin
   return w;
 }
 
-// --stats-json: the run's figures, for tools (docs/formats.md, "Overlay stats").
-void write_stats(const OverlayOptions& o, const pipeline::Overlay& overlay, std::chrono::steady_clock::time_point t0) {
+// --stats-json: the run's figures, for tools (docs/formats.md, "Overlay stats"). `started`:
+// when the command began (before the scene was read), `t0` when the frames began.
+void write_stats(const OverlayOptions& o, const pipeline::Overlay& overlay,
+                 std::chrono::steady_clock::time_point started, std::chrono::steady_clock::time_point t0) {
+  const auto first = overlay.first_composite_time();
+  const double startup_ms = first ? std::chrono::duration<double, std::milli>(*first - started).count() : -1.0;
+  if (first) spdlog::info("overlay: first frame composited {:.0f} ms after the command started", startup_ms);
   if (o.stats_json.empty()) return;
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  write_file_atomically(o.stats_json, pipeline::stage_times_json(overlay.times(), wall));
+  write_file_atomically(o.stats_json, pipeline::stage_times_json(overlay.times(), wall, startup_ms));
 }
 
 void report(const pipeline::Overlay& overlay) {
@@ -81,6 +86,7 @@ void report(const pipeline::Overlay& overlay) {
 }
 
 void run_live(OverlayOptions& o) {
+  const auto started = std::chrono::steady_clock::now();
   if (!o.recording.empty()) throw InputError("overlay: give --recording or --source, not both");
   if (!o.contact_sheet.empty()) throw InputError("--contact-sheet: a live run has no known length; use --frames-dir");
   if (o.poses != "tracker") throw InputError("--poses truth: a live source has no ground truth");
@@ -104,11 +110,12 @@ void run_live(OverlayOptions& o) {
     overlay.run(frame_sink(outputs));
   }
   outputs.commit();
-  write_stats(o, overlay.overlay(), t0);
+  write_stats(o, overlay.overlay(), started, t0);
   report(overlay.overlay());
 }
 
 void run_replay(const OverlayOptions& o) {
+  const auto started = std::chrono::steady_clock::now();
   if (o.recording.empty()) throw InputError("overlay: give --recording DIR, or --source SPEC for the live path");
   if (o.out.empty() && o.frames_dir.empty() && o.contact_sheet.empty() && !o.window && o.stats_json.empty())
     throw InputError("overlay: nothing to do; give --out, --frames-dir, --contact-sheet, --stats-json or --window");
@@ -158,7 +165,7 @@ void run_replay(const OverlayOptions& o) {
   if (stop_requested())
     throw Interrupted(fmt::format("overlay: after {} of {} frames; no output written", done, total));
   outputs.commit();
-  write_stats(o, overlay.overlay(), t0);
+  write_stats(o, overlay.overlay(), started, t0);
   const auto& stats = overlay.replay().tracker_stats();
   spdlog::info("overlay: {} frames{}; tracker: {} records, {} rejected, {} of {} bytes lost", overlay.times().frames,
                outputs.describe(), stats.records, stats.rejected_records, stats.lost_bytes(), stats.stream_bytes);

@@ -105,7 +105,11 @@ for name in ('decode video', 'virtual objects', 'shadows (moved objects)', 'read
 total = sum(stages.values())
 assert abs(s['latency_ms_mean'] - total) <= 0.05 * total + 2.0, (s['latency_ms_mean'], total)
 assert 1000.0 / s['fps'] >= 0.9 * total, (s['fps'], total)  # the run's wall time holds every stage
+# Start-up: the set-up before the first composite, which the frames' wall time excludes.
+assert s['startup_ms'] > 0 and s['startup_ms'] > total, (s['startup_ms'], total)
+print("ok: start-up %.0f ms, %.1f frames/s" % (s['startup_ms'], s['fps']))
 PY
+  grep -q "first frame composited" "$TMP/log" || fail "no start-up line"
 }
 
 case_window_without_display_fails_cleanly() {

@@ -168,6 +168,7 @@ OverlayFrame Overlay::composite(const capture::Frame& frame, const std::optional
   times_.blur += gt.blur_ms;
   times_.readback += gt.readback_ms;
   ++times_.frames;
+  if (!first_composite_) first_composite_ = std::chrono::steady_clock::now();
   return out;
 }
 
@@ -204,13 +205,14 @@ std::string format_stage_times(const StageTimes& t) {
   return text;
 }
 
-std::string stage_times_json(const StageTimes& t, double wall_seconds) {
+std::string stage_times_json(const StageTimes& t, double wall_seconds, double startup_ms) {
   const int n = std::max(1, t.frames);
   nlohmann::json stages = nlohmann::json::object();
   for (const auto& [name, ms] : t.stages()) stages[name] = ms / n;
   const nlohmann::json out = {{"frames", t.frames},
                               {"fps", wall_seconds > 0 ? t.frames / wall_seconds : 0.0},
                               {"latency_ms_mean", t.latency / n},
+                              {"startup_ms", startup_ms >= 0 ? nlohmann::json(startup_ms) : nlohmann::json()},
                               {"stages", stages}};
   return out.dump(2) + "\n";
 }

@@ -88,6 +88,7 @@ void Compositor::set_features(const gl::CompositeFeatures& features) {
 // Precomputes the shadow lines from the scene's receivers to its emitters (the objects
 // are the occluders), and with two objects or more their shadows on each other.
 void Compositor::build_shadows() {
+  const auto t0 = std::chrono::steady_clock::now();
   const ShadowScene shadow_scene(scene_);
   const auto& objects = shadow_scene.objects();
   const Mesh receivers = shadow_scene.receivers();
@@ -117,8 +118,9 @@ void Compositor::build_shadows() {
       bounce_->set_object_enabled(int(i), objects[i].bounce);
     }
     give_bounce_occlusion();
-    spdlog::debug("shadows: {} receivers, {} emitter patches, {} lines", receivers.positions.size(),
-                  emitters.patches.size(), shadows_->lines().lines.size());
+    spdlog::debug("shadows: {} receivers, {} emitter patches, {} lines, built in {:.0f} ms",
+                  receivers.positions.size(), emitters.patches.size(), shadows_->lines().lines.size(),
+                  std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
   }
   if (objects.size() >= 2) {
     object_shadows_ = std::make_shared<ObjectShadows>(emitters);

@@ -3,6 +3,7 @@
 // headless EGL), the compositor over the undistorted video, the video's radiometry
 // (response, vignetting, exposure: how the camera turned radiance into codes), the
 // lighting adaptation, and the time each stage took.
+#include <chrono>
 #include <memory>
 #include <optional>
 #include <string>
@@ -42,8 +43,8 @@ struct OverlaySettings {
 };
 
 struct StageTimes {  // milliseconds, summed over frames
-  double decode = 0, pose = 0, measure = 0, lighting = 0, shadows = 0, upload = 0, background = 0, depth = 0, objects = 0,
-         antialiasing = 0, blur = 0, readback = 0, output = 0;
+  double decode = 0, pose = 0, measure = 0, lighting = 0, shadows = 0, upload = 0, background = 0, depth = 0,
+         objects = 0, antialiasing = 0, blur = 0, readback = 0, output = 0;
   // From a frame's start (replay: its decode; live: the middle of its exposure) to its
   // composite handed on, summed over frames.
   double latency = 0;
@@ -92,6 +93,8 @@ class Overlay {
   const LoadedScene& scene() const { return compositor_->scene(); }
   gl::WindowContext* window() { return window_; }
   StageTimes& times() { return times_; }  // composite() fills the rendering stages; callers the rest
+  // When the first frame's composite was ready (steady clock); nullopt before it.
+  std::optional<std::chrono::steady_clock::time_point> first_composite_time() const { return first_composite_; }
   const StageTimes& times() const { return times_; }
   int frames_without_pose() const { return frames_without_pose_; }
   const LiveLighting* live_lighting() const { return live_lighting_ ? &*live_lighting_ : nullptr; }
@@ -117,13 +120,15 @@ class Overlay {
   std::optional<Nanos> first_frame_time_;
   void play_paths(Nanos frame_time);
   StageTimes times_;
+  std::optional<std::chrono::steady_clock::time_point> first_composite_;
   int frames_without_pose_ = 0;
 };
 
 // One line per stage: mean milliseconds per frame and share of the total.
 std::string format_stage_times(const StageTimes& t);
 // The run's figures as JSON (docs/formats.md, "Overlay stats"): frames, fps (frames over
-// `wall_seconds`), latency_ms_mean, and stages (name -> mean ms per frame).
-std::string stage_times_json(const StageTimes& t, double wall_seconds);
+// `wall_seconds`), latency_ms_mean, startup_ms (from the command's start to its first
+// composite; negative: none, written as null), and stages (name -> mean ms per frame).
+std::string stage_times_json(const StageTimes& t, double wall_seconds, double startup_ms = -1);
 
 }  // namespace lumar::pipeline
