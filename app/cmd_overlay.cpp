@@ -218,7 +218,8 @@ void register_overlay(CLI::App& app) {
   cmd->add_option("--max-frames", o->max_frames, "Stop after this many frames (0 = all)")->capture_default_str();
   add_composite_feature_options(cmd, o->without, o->blur_sigma);
   cmd->add_flag("--no-cache", o->no_cache,
-                "Build the irradiance volume without reading or writing the cache ($XDG_CACHE_HOME/lumar)");
+                "Build the irradiance volume and the shadow lines without reading or writing the cache "
+                "($XDG_CACHE_HOME/lumar)");
   // The live path (pipeline/live_overlay.h): --source and --tracker instead of --recording.
   pipeline::LiveOverlayOptions& live = o->live;
   cmd->add_option("--source", live.in.source, "Live: video:FILE, images:DIR, v4l2:/dev/videoN or recording:DIR");

@@ -274,7 +274,8 @@ void register_regress(CLI::App& app) {
   cmd->add_option("--scene", o->scene, "Scene manifest for every recording (default: the one its session names)");
   cmd->add_flag("--allow-incomplete", o->allow_incomplete,
                 "Accept recordings that were never closed (killed or crashed)");
-  cmd->add_flag("--no-cache", o->no_cache, "Build the irradiance volume without reading or writing the cache");
+  cmd->add_flag("--no-cache", o->no_cache,
+                "Build the irradiance volume and the shadow lines without reading or writing the cache");
   cmd->add_flag("--json", o->json,
                 "Print one JSON object per recording on stdout (keys: docs/ground_truth.md); the lines go to stderr");
   add_composite_feature_options(cmd, o->without, o->blur_sigma);

@@ -243,13 +243,17 @@ case_irradiance_cache_said_once_and_skippable() {
   export XDG_CACHE_HOME="$TMP/cache"
   "$LUMAR" overlay --recording "$REC" --max-frames 1 --frames-dir "$TMP/f1" >"$TMP/log1" 2>&1 || fail "overlay failed"
   grep -q "cached as $TMP/cache/lumar/irradiance-" "$TMP/log1" || { cat "$TMP/log1"; fail "the cache was not named"; }
-  [ "$(ls "$TMP/cache/lumar" | wc -l)" -eq 1 ] || fail "no volume in \$XDG_CACHE_HOME/lumar"
+  # The volume and the shadow lines.
+  [ "$(ls "$TMP/cache/lumar" | grep -c '^irradiance-')" -eq 1 ] || fail "no volume in \$XDG_CACHE_HOME/lumar"
+  [ "$(ls "$TMP/cache/lumar" | grep -c '^shadow-lines-')" -eq 1 ] || fail "no shadow lines in \$XDG_CACHE_HOME/lumar"
   "$LUMAR" overlay --recording "$REC" --max-frames 1 --frames-dir "$TMP/f2" >"$TMP/log2" 2>&1 || fail "overlay failed"
   ! grep -q "cached as" "$TMP/log2" || fail "the cache was announced again"
   export XDG_CACHE_HOME="$TMP/other"
   "$LUMAR" overlay --recording "$REC" --max-frames 1 --frames-dir "$TMP/f3" --no-cache >"$TMP/log3" 2>&1 ||
     fail "overlay --no-cache failed"
   [ ! -e "$TMP/other/lumar" ] || fail "--no-cache wrote the cache"
+  # Loaded (f2) or rebuilt (f3), the same frame.
+  cmp -s "$TMP/f1/frame-000000.png" "$TMP/f2/frame-000000.png" || fail "the cached volume and lines gave another frame"
   cmp -s "$TMP/f1/frame-000000.png" "$TMP/f3/frame-000000.png" || fail "a rebuilt volume gave another frame"
 }
 

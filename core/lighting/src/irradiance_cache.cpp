@@ -6,6 +6,7 @@
 #include <cstring>
 #include <fstream>
 
+#include "binary_file.h"
 #include "lumar/base/error.h"
 #include "lumar/base/output_file.h"
 #include "lumar/lighting/irradiance_volume.h"
@@ -18,39 +19,6 @@ namespace {
 // coincident faces (RayScene::intersect), so volumes built before may differ.
 constexpr char kMagic[8] = {'L', 'U', 'M', 'A', 'R', 'I', 'V', '3'};
 
-struct Writer {
-  std::ofstream out;
-  template <class T>
-  void value(const T& v) {
-    out.write(reinterpret_cast<const char*>(&v), sizeof(T));
-  }
-  template <class T>
-  void vector(const std::vector<T>& v) {
-    value(std::uint64_t(v.size()));
-    out.write(reinterpret_cast<const char*>(v.data()), std::streamsize(v.size() * sizeof(T)));
-  }
-};
-
-struct Reader {
-  std::ifstream in;
-  std::string name;
-  template <class T>
-  void value(T& v) {
-    in.read(reinterpret_cast<char*>(&v), sizeof(T));
-    if (!in) throw InputError(name + ": irradiance volume file is truncated; delete it to rebuild");
-  }
-  template <class T>
-  void vector(std::vector<T>& v) {
-    std::uint64_t n = 0;
-    value(n);
-    if (n > (std::uint64_t(1) << 32))
-      throw InputError(name + ": irradiance volume file is corrupt; delete it to rebuild");
-    v.resize(std::size_t(n));
-    in.read(reinterpret_cast<char*>(v.data()), std::streamsize(n * sizeof(T)));
-    if (!in) throw InputError(name + ": irradiance volume file is truncated; delete it to rebuild");
-  }
-};
-
 // Settings as plain numbers, in a fixed order (the file and the hash use it).
 template <class F>
 void visit_settings(VolumeSettings& s, F&& f) {
@@ -61,25 +29,13 @@ void visit_settings(VolumeSettings& s, F&& f) {
   s.storage = ProbeStorage(storage), s.separate_lights = sep, s.refine = refine, s.visibility = vis;
 }
 
-struct Fnv {
-  std::uint64_t h = 1469598103934665603ull;
-  void bytes(const void* p, std::size_t n) {
-    const auto* b = static_cast<const unsigned char*>(p);
-    for (std::size_t i = 0; i < n; ++i) h = (h ^ b[i]) * 1099511628211ull;
-  }
-  template <class T>
-  void value(const T& v) {
-    bytes(&v, sizeof(T));
-  }
-};
-
 }  // namespace
 
 void IrradianceVolume::save(const std::filesystem::path& file) const {
   const std::string name = file.string();
   OutputFile output(file);
   {
-    Writer w{std::ofstream(output.temporary(), std::ios::binary | std::ios::trunc)};
+    BinaryWriter w{std::ofstream(output.temporary(), std::ios::binary | std::ios::trunc)};
     if (!w.out) throw RuntimeError(name + ": cannot write the irradiance volume; check the folder's permissions");
     w.out.write(kMagic, sizeof(kMagic));
     VolumeSettings s = settings_;
@@ -99,7 +55,7 @@ void IrradianceVolume::save(const std::filesystem::path& file) const {
 }
 
 IrradianceVolume IrradianceVolume::load(const std::filesystem::path& file) {
-  Reader r{std::ifstream(file, std::ios::binary), file.string()};
+  BinaryReader r{std::ifstream(file, std::ios::binary), file.string(), "irradiance volume"};
   if (!r.in) throw InputError(r.name + ": irradiance volume file not found");
   char magic[sizeof(kMagic)] = {};
   r.in.read(magic, sizeof(magic));
@@ -134,7 +90,7 @@ IrradianceVolume IrradianceVolume::load(const std::filesystem::path& file) {
     ok = ok && v.depth_atlas.size() == std::size_t(v.atlas_width(v.depth_n)) * v.atlas_height(v.depth_n) * 2;
   for (const auto& node : v.node_probe)
     for (int k : node) ok = ok && k < int(P);
-  if (!ok) throw InputError(r.name + ": irradiance volume file is inconsistent; delete it to rebuild");
+  if (!ok) r.fail("inconsistent");
   return v;
 }
 

@@ -10,6 +10,7 @@
 #include "lumar/lighting/self_occlusion.h"
 #include "lumar/lighting/shadows/object_bounce.h"
 #include "lumar/lighting/shadows/object_shadows.h"
+#include "lumar/lighting/shadows/shadow_line_cache.h"
 #include "lumar/lighting/shadows/shadow_methods.h"
 #include "lumar/lighting/shadows/shadow_occlusion.h"
 
@@ -17,7 +18,7 @@ namespace lumar {
 
 Compositor::Compositor(std::shared_ptr<const LoadedScene> scene, const CameraIntrinsics& output_camera,
                        const cv::Mat& map_x, const cv::Mat& map_y, bool volume_cache)
-    : camera_(output_camera.without_distortion()), scene_(std::move(scene)) {
+    : camera_(output_camera.without_distortion()), scene_(std::move(scene)), cache_(volume_cache) {
   const LoadedScene& s = *scene_;
   sh_ = project_radiance_sh9(s.map);
   renderer_ = std::make_unique<gl::Renderer>(camera_);
@@ -108,7 +109,9 @@ void Compositor::build_shadows() {
   const Emitters emitters = shadow_scene.emitters(around.positions, around.normals, options);
   if (on_receivers) {
     shadows_ = std::make_shared<LineShadows>(
-        build_shadow_lines(receivers.positions, receivers.normals, emitters, shadow_scene.proxy()));
+        cache_
+            ? cached_shadow_lines(receivers.positions, receivers.normals, emitters, shadow_scene.proxy(), scene_->room)
+            : build_shadow_lines(receivers.positions, receivers.normals, emitters, shadow_scene.proxy()));
     for (std::size_t i = 0; i < objects.size(); ++i) shadows_->add_object(objects[i].model, poses_[i]);
     renderer_->set_receivers(receivers);
     bounce_ =
@@ -118,8 +121,8 @@ void Compositor::build_shadows() {
       bounce_->set_object_enabled(int(i), objects[i].bounce);
     }
     give_bounce_occlusion();
-    spdlog::debug("shadows: {} receivers, {} emitter patches, {} lines, built in {:.0f} ms",
-                  receivers.positions.size(), emitters.patches.size(), shadows_->lines().lines.size(),
+    spdlog::debug("shadows: {} receivers, {} emitter patches, {} lines, built in {:.0f} ms", receivers.positions.size(),
+                  emitters.patches.size(), shadows_->lines().lines.size(),
                   std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
   }
   if (objects.size() >= 2) {

@@ -34,8 +34,9 @@ class Compositor {
   // `output_camera`: the undistorted camera the renderer draws with. `map_x`, `map_y`:
   // for each output pixel, where to sample the distorted video (may be empty when the
   // video is already undistorted).
-  // `volume_cache`: load the irradiance volume from the disk cache, and store it there
-  // once built (lighting/irradiance_volume.h); false: build it every time.
+  // `volume_cache`: load the irradiance volume and the shadow lines from the disk cache,
+  // and store them there once built (lighting/irradiance_volume.h,
+  // lighting/shadows/shadow_line_cache.h); false: build them every time.
   Compositor(std::shared_ptr<const LoadedScene> scene, const CameraIntrinsics& output_camera, const cv::Mat& map_x,
              const cv::Mat& map_y, bool volume_cache = true);
 
@@ -92,6 +93,7 @@ class Compositor {
   std::unique_ptr<gl::Renderer> renderer_;
   std::shared_ptr<IrradianceVolume> volume_;  // shared_ptr: incomplete here
   void build_shadows();
+  bool cache_ = true;  // the volume and the shadow lines from the disk cache
   void bake_self_occlusion_once();
   void give_bounce_occlusion();
   std::vector<std::vector<VertexOcclusion>> self_occlusion_;  // per object, once baked
