@@ -21,7 +21,7 @@ namespace {
 struct ShadowsOptions {
   std::string scene, query, out, method = "lines";
   bool bounce = false;
-  int bounce_clusters = BounceSettings{}.samples;
+  int bounce_clusters = BounceSettings{}.clusters;
 };
 
 void write_result(const std::filesystem::path& path, const std::vector<glm::vec3>& attenuation) {
@@ -54,17 +54,16 @@ void register_shadows(CLI::App& app) {
       ->check(CLI::Range(1, 100000));
   add_action(cmd, [o] {
     const ShadowMethod method = parse_shadow_method(o->method);
-    if (o->bounce && method == ShadowMethod::Sphere)
-      throw InputError("--bounce: the sphere method (2004) has no bounce; use lines or reference");
+    ShadowMethodOptions options;
+    options.bounce = o->bounce;
+    options.bounce_settings.clusters = o->bounce_clusters;
+    check_shadow_options(method, options);  // before the scene's warnings
     LoadedScene scene = load_scene_files(std::filesystem::path(o->scene));
     refuse_output_over_input(o->out, {o->query, o->scene});
     const QueryPoints q = read_query_points(o->query);
     const std::vector<glm::vec3> positions(q.points.begin(), q.points.end()),
         normals(q.normals.begin(), q.normals.end());
     const ShadowScene shadows(std::move(scene));
-    ShadowMethodOptions options;
-    options.bounce = o->bounce;
-    options.bounce_settings.samples = o->bounce_clusters;
     const auto attenuation = shadow_attenuation(shadows, positions, normals, method, options);
     write_result(o->out, attenuation);
     spdlog::info("shadows ({}{}): {} points, {} occluder(s) -> {}", o->method, o->bounce ? ", with bounce" : "",

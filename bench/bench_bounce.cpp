@@ -50,7 +50,7 @@ struct Case {
   }
   std::unique_ptr<ObjectBounce> bounce(int clusters) const {
     BounceSettings settings;
-    settings.samples = clusters;
+    settings.clusters = clusters;
     auto b = std::make_unique<ObjectBounce>(lines.origins, receivers.normals, lines.unshadowed, settings);
     const LoadedObject& o = scene->objects().at(0);
     b->add_object(o.model, o.albedo, o.T_world_model);
@@ -161,7 +161,7 @@ int main(int argc, char** argv) {
       "figurine",
       [&figurine](benchmark::State& state) {
         tbb::global_control one_core(tbb::global_control::max_allowed_parallelism, 1);
-        const auto b = figurine.bounce(BounceSettings{}.samples);
+        const auto b = figurine.bounce(BounceSettings{}.clusters);
         int frame = 0;
         for (auto _ : state) {
           b->set_object_pose(0, translation(0.002 * (frame++ % 50), 0, 0) * figurine.scene->objects()[0].T_world_model);
@@ -189,14 +189,14 @@ int main(int argc, char** argv) {
     const auto* r = reporter.find(fmt::format("box/{}", k));
     if (r) report.entries.push_back({fmt::format("{}", k), r->time_ms, errors.at(fmt::format("box/{}", k))});
   }
-  report.highlight = fmt::format("{}", BounceSettings{}.samples);
+  report.highlight = fmt::format("{}", BounceSettings{}.clusters);
   report.compute_ratios();
   const auto* fig = reporter.find("figurine");
-  const auto* def = reporter.find(fmt::format("box/{}", BounceSettings{}.samples));
+  const auto* def = reporter.find(fmt::format("box/{}", BounceSettings{}.clusters));
   report.note = fmt::format(
       "default {} clusters: box {:.2f} ms/frame, error {:.3f}; the figurine gliding over the sample floor: {:.2f} "
       "ms/frame; reference {:.0f} ms (all cores)",
-      BounceSettings{}.samples, def ? def->time_ms : 0.0, errors.at(fmt::format("box/{}", BounceSettings{}.samples)),
+      BounceSettings{}.clusters, def ? def->time_ms : 0.0, errors.at(fmt::format("box/{}", BounceSettings{}.clusters)),
       fig ? fig->time_ms : 0.0, reference_ms);
   if (report.entries.size() == cluster_counts.size() + 1) {
     report.save(bench::results_dir());

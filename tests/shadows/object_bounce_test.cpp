@@ -107,7 +107,7 @@ TEST(ObjectBounce, SphereOnAPlaneSendsItsAlbedoTimesWhatItBlocks) {
   // ones see it as a point. Few large clusters or many small ones: within 3 %.
   for (int samples : {16, 256}) {
     BounceSettings settings;
-    settings.samples = samples;
+    settings.clusters = samples;
     ObjectBounce bounce(positions, normals, without, settings);
     bounce.add_object(test::make_sphere({0, 0, 0}, float(R), 96, 48), glm::vec3(float(albedo)), translation(0, R, 0));
     ASSERT_TRUE(bounce.update(uniform));

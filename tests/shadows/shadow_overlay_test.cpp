@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <fstream>
+#include <functional>
 #include <glm/gtc/matrix_transform.hpp>
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
@@ -73,6 +74,36 @@ cv::Mat room_video(Compositor& compositor, const CameraIntrinsics& camera, const
   return video;
 }
 
+// Pixels whose channel `c` (BGR) differs by more than 1 between `on` and `off` (each
+// change must go the way `direction` says: +1 brighter, -1 darker), and how many of them
+// see a floor point (y = 0) farther than 10 cm from every receiver origin `counts` accepts.
+struct FloorChanges {
+  int changed = 0, unexplained = 0;
+};
+FloorChanges floor_changes(const cv::Mat& on, const cv::Mat& off, int c, int direction, const CameraIntrinsics& camera,
+                           const Pose& pose, const std::vector<glm::vec3>& origins,
+                           const std::function<bool(std::size_t)>& counts) {
+  const glm::dvec3 eye = pose.translation;
+  FloorChanges out;
+  for (int v = 0; v < on.rows; ++v)
+    for (int u = 0; u < on.cols; ++u) {
+      const int a = on.at<cv::Vec3b>(v, u)[c], b = off.at<cv::Vec3b>(v, u)[c];
+      if (std::abs(a - b) <= 1) continue;
+      ++out.changed;
+      EXPECT_GT(direction * (a - b), 0) << "pixel " << u << "," << v << " changed the other way";
+      const glm::dvec3 ray =
+          pose.rotation_matrix() * glm::dvec3((u - camera.cx) / camera.fx, (v - camera.cy) / camera.fy, 1.0);
+      bool explained = false;
+      if (ray.y < 0) {
+        const glm::dvec3 p = eye + (-eye.y / ray.y) * ray;
+        for (std::size_t i = 0; i < origins.size() && !explained; ++i)
+          explained = counts(i) && glm::length(glm::dvec3(origins[i]) - p) < 0.1;
+      }
+      out.unexplained += !explained;
+    }
+  return out;
+}
+
 // The sample scene seen from frame 15 of the sample recording, with a current context.
 struct SampleView {
   CameraIntrinsics camera;
@@ -137,28 +168,11 @@ TEST(ShadowOverlay, VideoDarkensWhereTheLinesSayAndNowhereElse) {
   EXPECT_GE(checked, 10);
 
   // Nowhere else: every pixel that changed sees the floor near a shadowed vertex.
-  const glm::dvec3 eye = pose.translation;
-  int changed = 0, unexplained = 0;
-  for (int v = 0; v < on.rows; ++v)
-    for (int u = 0; u < on.cols; ++u) {
-      const cv::Vec3b a = on.at<cv::Vec3b>(v, u), b = off.at<cv::Vec3b>(v, u);
-      if (std::abs(int(a[1]) - int(b[1])) <= 1) continue;
-      ++changed;
-      EXPECT_LT(int(a[1]), int(b[1])) << "shadows only darken";
-      // The floor point this pixel sees (y = 0).
-      const glm::dvec3 ray =
-          pose.rotation_matrix() * glm::dvec3((u - camera.cx) / camera.fx, (v - camera.cy) / camera.fy, 1.0);
-      bool near_shadow = false;
-      if (ray.y < 0) {
-        const glm::dvec3 p = eye + (-eye.y / ray.y) * ray;
-        for (std::size_t i = 0; i < origins.size() && !near_shadow; ++i)
-          near_shadow = att[i].g < 0.995f && glm::length(glm::dvec3(origins[i]) - p) < 0.1;
-      }
-      unexplained += !near_shadow;
-    }
-  std::printf("%d pixels darkened, %d of them away from a predicted shadow\n", changed, unexplained);
-  EXPECT_GT(changed, 100);
-  EXPECT_EQ(unexplained, 0);
+  const FloorChanges darker =
+      floor_changes(on, off, 1, -1, camera, pose, origins, [&](std::size_t i) { return att[i].g < 0.995f; });
+  std::printf("%d pixels darkened, %d of them away from a predicted shadow\n", darker.changed, darker.unexplained);
+  EXPECT_GT(darker.changed, 100);
+  EXPECT_EQ(darker.unexplained, 0);
 }
 
 // A saturated red box beside the figurine: with bounce on, the floor around it turns
@@ -227,27 +241,12 @@ TEST(ShadowOverlay, ARedBoxTintsTheFloorBesideIt) {
   EXPECT_EQ(redder, checked);
 
   // Nowhere else: a pixel that changed sees the floor near a receiver the box lights.
-  const glm::dvec3 eye = pose.translation;
-  int changed = 0, unexplained = 0;
-  for (int v = 0; v < on.rows; ++v)
-    for (int u = 0; u < on.cols; ++u) {
-      const cv::Vec3b a = on.at<cv::Vec3b>(v, u), b = off.at<cv::Vec3b>(v, u);
-      if (std::abs(int(a[2]) - int(b[2])) <= 1) continue;
-      ++changed;
-      EXPECT_GT(int(a[2]), int(b[2])) << "bounce only adds light";
-      const glm::dvec3 ray =
-          pose.rotation_matrix() * glm::dvec3((u - camera.cx) / camera.fx, (v - camera.cy) / camera.fy, 1.0);
-      bool near_bounce = false;
-      if (ray.y < 0) {
-        const glm::dvec3 p = eye + (-eye.y / ray.y) * ray;
-        for (std::size_t i = 0; i < origins.size() && !near_bounce; ++i)
-          near_bounce = bounce[i].r > 0.002f && glm::length(glm::dvec3(origins[i]) - p) < 0.1;
-      }
-      unexplained += !near_bounce;
-    }
-  std::printf("%d pixels redder, %d of them away from the box's light\n", changed, unexplained);
-  EXPECT_GT(changed, 100);
-  EXPECT_EQ(unexplained, 0);
+  const FloorChanges redder_pixels =
+      floor_changes(on, off, 2, +1, camera, pose, origins, [&](std::size_t i) { return bounce[i].r > 0.002f; });
+  std::printf("%d pixels redder, %d of them away from the box's light\n", redder_pixels.changed,
+              redder_pixels.unexplained);
+  EXPECT_GT(redder_pixels.changed, 100);
+  EXPECT_EQ(redder_pixels.unexplained, 0);
 }
 
 // Two figurines, one hovering above and beside the other: where the CPU says the upper

@@ -4,6 +4,8 @@
 // and the FNV-1a hash their cache keys are made of. A truncated or corrupt file is an
 // InputError naming it and saying to delete it, never a crash.
 #include <cstdint>
+#include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <string>
 #include <vector>
@@ -29,6 +31,16 @@ struct BinaryReader {
   std::ifstream in;
   std::string name;  // the file
   std::string what;  // what it holds, e.g. "irradiance volume"
+
+  // Opens `file` and checks that it starts with `magic` (a format and its version).
+  BinaryReader(const std::filesystem::path& file, std::string holds, const char (&magic)[8])
+      : in(file, std::ios::binary), name(file.string()), what(std::move(holds)) {
+    if (!in) throw InputError(name + ": " + what + " file not found");
+    char start[8] = {};
+    in.read(start, sizeof(start));
+    if (!in || std::memcmp(start, magic, sizeof(start)) != 0)
+      throw InputError(name + ": not a Lumar " + what + " file (or an older version); delete it to rebuild");
+  }
   [[noreturn]] void fail(const std::string& problem) const {
     throw InputError(name + ": " + what + " file is " + problem + "; delete it to rebuild");
   }

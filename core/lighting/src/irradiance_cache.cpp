@@ -3,7 +3,6 @@
 #include <spdlog/spdlog.h>
 
 #include <cstdlib>
-#include <cstring>
 #include <fstream>
 
 #include "binary_file.h"
@@ -55,12 +54,7 @@ void IrradianceVolume::save(const std::filesystem::path& file) const {
 }
 
 IrradianceVolume IrradianceVolume::load(const std::filesystem::path& file) {
-  BinaryReader r{std::ifstream(file, std::ios::binary), file.string(), "irradiance volume"};
-  if (!r.in) throw InputError(r.name + ": irradiance volume file not found");
-  char magic[sizeof(kMagic)] = {};
-  r.in.read(magic, sizeof(magic));
-  if (!r.in || std::memcmp(magic, kMagic, sizeof(kMagic)) != 0)
-    throw InputError(r.name + ": not a Lumar irradiance volume (or an older version); delete it to rebuild");
+  BinaryReader r(file, "irradiance volume", kMagic);
   IrradianceVolume v;
   visit_settings(v.settings_, [&](auto& x) { r.value(x); });
   r.value(v.stats_);

@@ -187,19 +187,10 @@ cv::Mat Compositor::composite(const cv::Mat& video_bgr8, const std::optional<Pos
   if (shadows_ && shadows_enabled_) {
     const bool bounce = bounce_ && renderer_->features().bounce;
     bool changed = shadows_->update();
-    if (bounce)
-      changed |= bounce_->update([this](const glm::vec3& p, const glm::vec3& n) {
-        return volume_ ? glm::vec3(volume_->evaluate(glm::dvec3(p), glm::dvec3(n)))
-                       : glm::vec3(sh9_irradiance(sh_, glm::dvec3(n)));
-      });
+    if (bounce) changed |= bounce_->update(object_irradiance(volume_.get(), sh_));
     if (changed || !shadows_uploaded_) {
-      if (bounce) {
-        std::vector<glm::vec3> light = shadows_->attenuation();
-        for (std::size_t i = 0; i < light.size(); ++i) light[i] += bounce_->ratio()[i];
-        renderer_->set_receiver_attenuation(light);
-      } else {
-        renderer_->set_receiver_attenuation(shadows_->attenuation());
-      }
+      renderer_->set_receiver_attenuation(bounce ? with_bounce(shadows_->attenuation(), *bounce_)
+                                                 : shadows_->attenuation());
       shadows_uploaded_ = true;
     }
   }

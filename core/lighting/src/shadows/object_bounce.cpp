@@ -9,12 +9,18 @@
 
 #include "lumar/base/constants.h"
 #include "lumar/base/error.h"
+#include "lumar/lighting/irradiance_volume.h"
 
 namespace lumar {
 
 namespace {
 
 glm::vec3 corner(const Mesh& m, std::uint32_t t, int k) { return m.positions[m.indices[3 * t + std::uint32_t(k)]]; }
+// Where triangle t faces, from its vertex normals (a scan's winding is not always
+// consistent); not normalised.
+glm::vec3 vertex_normal_sum(const Mesh& m, std::uint32_t t) {
+  return m.normals[m.indices[3 * t]] + m.normals[m.indices[3 * t + 1]] + m.normals[m.indices[3 * t + 2]];
+}
 
 // Form factor from a point (origin) with unit normal n to a triangle a, b, c (relative
 // to the point), clipped to the point's upper half-space: Lambert's contour integral,
@@ -63,8 +69,7 @@ SurfaceClusters surface_clusters(const Mesh& mesh, int count, int children) {
   for (std::uint32_t t = 0; t < triangles; ++t) {
     const glm::vec3 a = corner(mesh, t, 0), b = corner(mesh, t, 1), c = corner(mesh, t, 2);
     const glm::vec3 centre = (a + b + c) / 3.0f;
-    glm::vec3 n = mesh.normals[mesh.indices[3 * t]] + mesh.normals[mesh.indices[3 * t + 1]] +
-                  mesh.normals[mesh.indices[3 * t + 2]];
+    glm::vec3 n = vertex_normal_sum(mesh, t);
     if (glm::length(n) > 0) n = glm::normalize(n) * normal_scale;
     key[t] = {centre.x, centre.y, centre.z, n.x, n.y, n.z};
     area[t] = 0.5 * glm::length(glm::cross(glm::dvec3(b - a), glm::dvec3(c - a)));
@@ -133,8 +138,7 @@ SurfaceClusters surface_clusters(const Mesh& mesh, int count, int children) {
       for (std::uint32_t i = r.first; i < r.first + r.count; ++i) {
         const std::uint32_t t = order[i];
         centre += area[t] * glm::dvec3(corner(mesh, t, 0) + corner(mesh, t, 1) + corner(mesh, t, 2)) / 3.0;
-        normal += area[t] * glm::dvec3(mesh.normals[mesh.indices[3 * t]] + mesh.normals[mesh.indices[3 * t + 1]] +
-                                       mesh.normals[mesh.indices[3 * t + 2]]);
+        normal += area[t] * glm::dvec3(vertex_normal_sum(mesh, t));
       }
       c.centre = r.area > 0 ? glm::vec3(centre / r.area) : corner(mesh, order[r.first], 0);
       c.normal = glm::length(normal) > 0 ? glm::vec3(glm::normalize(normal)) : glm::vec3(0.0f);
@@ -166,7 +170,7 @@ ObjectBounce::ObjectBounce(std::vector<glm::vec3> positions, std::vector<glm::ve
       settings_(settings) {
   if (normals_.size() != positions_.size() || unshadowed_.size() != positions_.size())
     throw InputError("bounce: receiver positions, normals and irradiance differ in count");
-  if (settings_.samples < 1) throw InputError("bounce: at least one surface sample per object");
+  if (settings_.clusters < 1) throw InputError("bounce: at least one surface cluster per object");
   bounce_.assign(positions_.size(), glm::vec3(0.0f));
   ratio_.assign(positions_.size(), glm::vec3(0.0f));
 }
@@ -177,15 +181,17 @@ int ObjectBounce::add_object(const Mesh& model, const glm::vec3& albedo, const g
   o.model = model;
   o.albedo = albedo;
   o.T_world_model = T_world_model;
-  o.surface = surface_clusters(model, settings_.samples);
+  o.surface = surface_clusters(model, settings_.clusters);
+  const auto [lo, hi] = model.bounds();
+  o.middle = 0.5f * (lo + hi);
+  o.radius = 0.5f * glm::length(hi - lo);
   const std::size_t triangles = model.triangle_count();
   o.triangle_centre.resize(triangles), o.triangle_facing.resize(triangles);
   o.triangle_area.resize(triangles), o.triangle_radius.resize(triangles);
   for (std::uint32_t t = 0; t < triangles; ++t) {
     const glm::vec3 a = corner(model, t, 0), b = corner(model, t, 1), c = corner(model, t, 2);
     const glm::vec3 centre = (a + b + c) / 3.0f;
-    const glm::vec3 f = model.normals[model.indices[3 * t]] + model.normals[model.indices[3 * t + 1]] +
-                        model.normals[model.indices[3 * t + 2]];
+    const glm::vec3 f = vertex_normal_sum(model, t);
     o.triangle_centre[t] = centre;
     o.triangle_facing[t] = glm::length(f) > 0 ? glm::normalize(f) : f;
     o.triangle_area[t] = 0.5f * glm::length(glm::cross(b - a, c - a));
@@ -266,7 +272,6 @@ bool ObjectBounce::update(const Irradiance& irradiance) {
   stats_ = {};
   stats_.recomputed = true;
   std::fill(bounce_.begin(), bounce_.end(), glm::vec3(0.0f));
-  std::vector<std::uint8_t> reached(positions_.size(), 0);
   for (const Object& o : objects_)
     if (o.enabled && !o.surface.clusters.empty()) add_object_bounce(o, irradiance);
   for (std::size_t i = 0; i < positions_.size(); ++i) {
@@ -287,9 +292,8 @@ void ObjectBounce::add_object_bounce(const Object& o, const Irradiance& irradian
   const float area_scale = float(scale * scale);
   const glm::vec3 albedo_over_pi = o.albedo / float(kPi);
   const Mesh& m = o.model;
-  const auto [model_lo, model_hi] = m.bounds();
-  const glm::vec3 middle = glm::vec3(T * glm::dvec4(glm::dvec3(0.5f * (model_lo + model_hi)), 1.0));
-  const float reach = float(settings_.reach * scale) * std::max(0.5f * glm::length(model_hi - model_lo), 1e-6f);
+  const glm::vec3 middle = glm::vec3(Tf * glm::vec4(o.middle, 1.0f));
+  const float reach = float(settings_.reach * scale) * std::max(o.radius, 1e-6f);
 
   // The clusters, posed, as a structure of arrays padded to a multiple of 4 for the
   // receivers' loop: centre, normal, radiance × open (the share of the light that leaves
@@ -395,6 +399,19 @@ void ObjectBounce::add_object_bounce(const Object& o, const Irradiance& irradian
     stats_.pairs += n - near.size();
     stats_.near_pairs += near.size();
   }
+}
+
+ObjectBounce::Irradiance object_irradiance(const IrradianceVolume* volume, const SH9& sh) {
+  if (volume)
+    return [volume](const glm::vec3& p, const glm::vec3& n) {
+      return glm::vec3(volume->evaluate(glm::dvec3(p), glm::dvec3(n)));
+    };
+  return [sh](const glm::vec3&, const glm::vec3& n) { return glm::vec3(sh9_irradiance(sh, glm::dvec3(n))); };
+}
+
+std::vector<glm::vec3> with_bounce(std::vector<glm::vec3> attenuation, const ObjectBounce& bounce) {
+  for (std::size_t i = 0; i < attenuation.size(); ++i) attenuation[i] += bounce.ratio()[i];
+  return attenuation;
 }
 
 }  // namespace lumar

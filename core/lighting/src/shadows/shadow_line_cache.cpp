@@ -3,7 +3,6 @@
 #include <spdlog/spdlog.h>
 
 #include <chrono>
-#include <cstring>
 
 #include "binary_file.h"
 #include "lumar/base/error.h"
@@ -34,12 +33,7 @@ void save_shadow_lines(const ShadowLines& l, const std::filesystem::path& file) 
 }
 
 ShadowLines load_shadow_lines(const std::filesystem::path& file) {
-  BinaryReader r{std::ifstream(file, std::ios::binary), file.string(), "shadow lines"};
-  if (!r.in) throw InputError(r.name + ": shadow lines file not found");
-  char magic[sizeof(kMagic)] = {};
-  r.in.read(magic, sizeof(magic));
-  if (!r.in || std::memcmp(magic, kMagic, sizeof(kMagic)) != 0)
-    throw InputError(r.name + ": not a Lumar shadow lines file (or an older version); delete it to rebuild");
+  BinaryReader r(file, "shadow lines", kMagic);
   ShadowLines l;
   std::uint8_t distant = 0;
   std::uint64_t candidates = 0;

@@ -3,6 +3,7 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <optional>
 
 #include "lumar/base/error.h"
 #include "lumar/lighting/composite_reference.h"
@@ -209,26 +210,18 @@ std::vector<glm::vec3> reference_with_bounce(const ShadowScene& scene, const std
   return out;
 }
 
-// What shades the objects, on the CPU: the scene's irradiance volume, or SH9.
-ObjectBounce::Irradiance scene_object_irradiance(const ShadowScene& scene, bool volume_cache,
-                                                 std::shared_ptr<const IrradianceVolume>& volume) {
-  const std::string& method = scene.scene().manifest.lighting.method;
-  if (method == "sh9") {
-    const SH9 sh = project_radiance_sh9(scene.map());
-    return [sh](const glm::vec3&, const glm::vec3& n) { return glm::vec3(sh9_irradiance(sh, glm::dvec3(n))); };
-  }
-  volume = std::make_shared<const IrradianceVolume>(scene_irradiance_volume(scene.scene(), method, volume_cache));
-  return [v = volume.get()](const glm::vec3& p, const glm::vec3& n) {
-    return glm::vec3(v->evaluate(glm::dvec3(p), glm::dvec3(n)));
-  };
-}
-
 }  // namespace
+
+void check_shadow_options(ShadowMethod method, const ShadowMethodOptions& options) {
+  if (options.bounce && method == ShadowMethod::Sphere)
+    throw InputError("--bounce: the sphere method (2004) has no bounce; use lines or reference");
+}
 
 std::vector<glm::vec3> shadow_attenuation(const ShadowScene& scene, const std::vector<glm::vec3>& positions,
                                           const std::vector<glm::vec3>& normals, ShadowMethod method,
                                           const ShadowMethodOptions& options) {
   check_points(positions, normals);
+  check_shadow_options(method, options);
   switch (method) {
     case ShadowMethod::Reference: {
       if (options.bounce) return reference_with_bounce(scene, positions, normals);
@@ -236,7 +229,6 @@ std::vector<glm::vec3> shadow_attenuation(const ShadowScene& scene, const std::v
       return reference_attenuation(positions, normals, e, scene.proxy(), *scene.occluders());
     }
     case ShadowMethod::Sphere: {
-      if (options.bounce) throw InputError("--bounce: the sphere method (2004) has no bounce; use lines or reference");
       EmitterOptions eo = sphere_baseline_emitter_options();
       eo.map_width = options.emitters.map_width;
       const Emitters e = scene.emitters(positions, normals, eo);
@@ -257,11 +249,12 @@ std::vector<glm::vec3> shadow_attenuation(const ShadowScene& scene, const std::v
         bounce.set_object_enabled(id, o.bounce);
         if (o.bounce) bounce.set_object_occlusion(id, bake_self_occlusion(o.model));
       }
-      std::shared_ptr<const IrradianceVolume> volume;
-      bounce.update(scene_object_irradiance(scene, options.volume_cache, volume));
-      std::vector<glm::vec3> out = shadows.attenuation();
-      for (std::size_t i = 0; i < out.size(); ++i) out[i] += bounce.ratio()[i];
-      return out;
+      // The objects shaded as the overlay shades them: the scene's volume, or SH9.
+      const std::string& lighting = scene.scene().manifest.lighting.method;
+      std::optional<IrradianceVolume> volume;
+      if (lighting != "sh9") volume = scene_irradiance_volume(scene.scene(), lighting, options.volume_cache);
+      bounce.update(object_irradiance(volume ? &*volume : nullptr, volume ? SH9{} : project_radiance_sh9(scene.map())));
+      return with_bounce(shadows.attenuation(), bounce);
     }
   }
 }

@@ -3,7 +3,7 @@
 // rendering adds it as well as removing what the objects block, so a red box tints the
 // white floor beside it (docs/shadows.md, "Bounce").
 //
-// Each object's surface is cut into `samples` clusters of about equal area (median cuts
+// Each object's surface is cut into `clusters` clusters of about equal area (median cuts
 // of its triangles by position and normal, once, in model space). Per
 // frame, after a move, a cluster's radiance is albedo/π × open × E(bent normal): E from
 // the irradiance volume (or SH9) that shades the object, open and the bent normal from
@@ -30,12 +30,15 @@
 #include <vector>
 
 #include "lumar/lighting/self_occlusion.h"
+#include "lumar/lighting/sh.h"
 #include "lumar/scene/mesh.h"
 
 namespace lumar {
 
+class IrradianceVolume;
+
 struct BounceSettings {
-  int samples = 128;        // surface clusters per object: the quality knob (bench_bounce)
+  int clusters = 128;       // surface clusters per object: the quality knob (bench_bounce)
   double near_radii = 3.0;  // a cluster nearer than this many of its radii is summed by triangles
   double reach = 8.0;       // in bounding radii of the object
 };
@@ -109,6 +112,8 @@ class ObjectBounce {
     glm::vec3 albedo{0.8f};
     glm::dmat4 T_world_model{1.0};
     SurfaceClusters surface;
+    glm::vec3 middle{0.0f};  // of the model's bounding box
+    float radius = 0;        // half its diagonal
     bool enabled = true;
     // Model space, once: per cluster the area-weighted bent normal (unit) and open share
     // of its vertices (self-occlusion, or the normals and 1); per triangle its centre,
@@ -128,5 +133,12 @@ class ObjectBounce {
   bool dirty_ = true;
   BounceStats stats_;
 };
+
+// What shades the objects, on the CPU: the irradiance volume when there is one (the
+// scene's lighting.method is not "sh9"), else the map's SH9.
+ObjectBounce::Irradiance object_irradiance(const IrradianceVolume* volume, const SH9& sh);
+
+// The shadow's E_with / E_without per receiver plus the bounce's E_bounce / E_without.
+std::vector<glm::vec3> with_bounce(std::vector<glm::vec3> attenuation, const ObjectBounce& bounce);
 
 }  // namespace lumar

@@ -96,6 +96,10 @@ struct ShadowMethodOptions {
   bool volume_cache = true;
 };
 
+// InputError for options the method cannot honour (bounce with the sphere method), so a
+// command can refuse them before it reads its inputs.
+void check_shadow_options(ShadowMethod method, const ShadowMethodOptions& options);
+
 // Attenuation of each point (unit normals) by the scene's objects in their poses:
 // E_with / E_without per channel in [0, 1]; with bounce, (E_with + E_bounce) / E_without,
 // which may exceed 1.
