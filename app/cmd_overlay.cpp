@@ -78,8 +78,12 @@ void write_stats(const OverlayOptions& o, const pipeline::Overlay& overlay,
 
 void report(const pipeline::Overlay& overlay) {
   if (const auto* lighting = overlay.live_lighting())
-    spdlog::info("overlay: lighting scale {:.3f} after {} comparisons of the video with the map", lighting->scale(),
-                 lighting->measurements());
+    spdlog::info(
+        "overlay: lighting scale {:.3f} after {} comparisons of the video with the map: {} of {} map cells seen, "
+        "{} re-bakes (the last {:.0f} ms)",
+        lighting->scale(), lighting->measurements(), lighting->adapter().measured_cells(),
+        lighting->adapter().settings().cell_cols * lighting->adapter().settings().cell_rows, lighting->bakes(),
+        lighting->last_bake_ms());
   if (overlay.frames_without_pose() > 0)
     spdlog::warn("overlay: {} frames had no tracker pose and show the video alone", overlay.frames_without_pose());
   spdlog::info("{}", pipeline::format_stage_times(overlay.times()));

@@ -59,8 +59,10 @@ void register_synth(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--latency-ms", s->latency_ms, "Tracker latency in milliseconds")->capture_default_str();
   cmd->add_option("--arc-deg", s->arc_deg, "How far the camera orbits the object, degrees")->capture_default_str();
-  cmd->add_option("--path", s->path, "The camera's path: orbit, or still (held where the orbit ends)")
-      ->check(CLI::IsMember({"orbit", "still"}))
+  cmd->add_option("--path", s->path,
+                  "The camera's path: orbit, still (held where the orbit ends), or room (standing back, turning slowly "
+                  "across the object to the far wall)")
+      ->check(CLI::IsMember({"orbit", "still", "room"}))
       ->capture_default_str();
   cmd->add_option("--codec", s->codec, "Video codec: mjpeg (near-lossless) or ffv1 (lossless)")
       ->check(CLI::IsMember({"mjpeg", "ffv1"}))
@@ -72,6 +74,22 @@ void register_synth(CLI::App& app) {
                 "their masks (docs/ground_truth.md)");
   cmd->add_option("--truth-seed", s->truth_seed,
                   "--truth: the noise seed of the second truth (truth/other-seed-*), the noise floor; 0 = --seed + 1")
+      ->capture_default_str();
+  // A change of the room's light during the recording.
+  auto change_box = std::make_shared<std::vector<double>>();
+  auto change_scale = std::make_shared<std::vector<double>>();
+  auto change = std::make_shared<sim::LightChange>();
+  cmd->add_option("--change-box", *change_box,
+                  "The room's light changes where the map's texels lie on the proxy inside this world box: "
+                  "X0 Y0 Z0 X1 Y1 Z1 metres (with --change-scale)")
+      ->expected(6);
+  cmd->add_option("--change-scale", *change_scale, "--change-box: RGB factor, e.g. 0 0 0 for a lamp going out")
+      ->expected(3);
+  cmd->add_option("--change-brighter-than", change->brighter_than,
+                  "--change-box: only texels of at least this luminance change (a lamp, not the ceiling around it)")
+      ->capture_default_str();
+  cmd->add_option("--change-at", change->at_s, "--change-box: when, seconds into the recording")->capture_default_str();
+  cmd->add_option("--change-ramp", change->ramp_s, "--change-box: how long it takes, seconds (0: at once)")
       ->capture_default_str();
   // --board: the tracked camera filming a checkerboard, for `lumar calibrate-rig`.
   auto b = std::make_shared<sim::BoardSynthSettings>();
@@ -85,8 +103,18 @@ void register_synth(CLI::App& app) {
   cmd->add_option("--image-noise", b->image_noise, "--board: image noise, 8-bit levels RMS")->capture_default_str();
   auto sweep = std::make_shared<SweepOptions>();
   add_sweep_options(cmd, *sweep);
-  add_action(cmd, [cmd, s, camera_file, b, board, sweep] {
+  add_action(cmd, [cmd, s, camera_file, b, board, sweep, change_box, change_scale, change] {
     catch_stop_signals();  // Ctrl-C stops between frames; the unfinished recording is removed
+    if (change_box->empty() != change_scale->empty())
+      throw InputError("synth: --change-box and --change-scale go together");
+    if (!change_box->empty()) {
+      const auto& v = *change_box;
+      change->region.min = glm::min(glm::dvec3(v[0], v[1], v[2]), glm::dvec3(v[3], v[4], v[5]));
+      change->region.max = glm::max(glm::dvec3(v[0], v[1], v[2]), glm::dvec3(v[3], v[4], v[5]));
+      change->scale = glm::dvec3((*change_scale)[0], (*change_scale)[1], (*change_scale)[2]);
+      if (change->at_s < 0 || change->ramp_s < 0) throw InputError("synth: --change-at and --change-ramp must be >= 0");
+      s->light_change = *change;
+    }
     if (sweep->sweep) {
       if (sweep->envmap.empty()) throw InputError("synth --sweep: give the map to sweep with --envmap MAP.exr");
       sim::SweepSynthSettings settings = sweep->settings;

@@ -114,4 +114,29 @@ case_synth_refuses_existing_output() {
   [ -e "$TMP/rec/keep-me" ] || fail "synth touched an existing folder"
 }
 
+case_light_change_darkens_the_lamp_and_refuses_bad_boxes() {
+  # The ceiling lamp at (-1.2, 3, 0.3) goes out half-way through a recording looking up at it:
+  # the last frame is darker than the first where the lamp was; no other change.
+  "$LUMAR" synth --scene "$SCENE" --camera "$CAM" --out "$TMP/rec" --frames 4 --supersample 1 --path room \
+    --change-box -1.45 2.9 0.15 -0.95 3.1 0.45 --change-brighter-than 5 --change-scale 0 0 0 --change-at 0.05 \
+    >"$TMP/log" 2>&1 || { cat "$TMP/log"; fail "synth with a light change failed"; }
+  "$LUMAR" synth --scene "$SCENE" --camera "$CAM" --out "$TMP/same" --frames 4 --supersample 1 --path room \
+    >"$TMP/log" 2>&1 || { cat "$TMP/log"; fail "synth failed"; }
+  "$LUMAR" overlay --recording "$TMP/rec" --without all --frames-dir "$TMP/changed" >"$TMP/log" 2>&1 || fail "overlay"
+  "$LUMAR" overlay --recording "$TMP/same" --without all --frames-dir "$TMP/unchanged" >"$TMP/log" 2>&1 || fail "overlay"
+  first=$(python3 "$(dirname "$0")/png_tool.py" mean-abs-diff "$TMP/changed/frame-000000.png" "$TMP/unchanged/frame-000000.png")
+  last=$(python3 "$(dirname "$0")/png_tool.py" mean-abs-diff "$TMP/changed/frame-000003.png" "$TMP/unchanged/frame-000003.png")
+  python3 -c "import sys; sys.exit(0 if $first < 0.001 and $last > 0.01 else 1)" ||
+    fail "frame 0 differs by $first levels (want ~0, before the change), frame 3 by $last (want the lamp gone)"
+  echo "ok: before the change $first levels from the unchanged room, after $last"
+  for box in "10 10 10 11 11 11" "-1 -1 -1 1 1"; do
+    # shellcheck disable=SC2086
+    "$LUMAR" synth --scene "$SCENE" --camera "$CAM" --out "$TMP/bad" --frames 2 --supersample 1 \
+      --change-box $box --change-scale 0 0 0 2>"$TMP/err" >/dev/null
+    [ $? -eq 2 ] || fail "--change-box $box: expected exit status 2"
+    [ ! -e "$TMP/bad" ] || fail "--change-box $box: a recording was left behind"
+    echo "ok: $(tail -1 "$TMP/err")"
+  done
+}
+
 run_case

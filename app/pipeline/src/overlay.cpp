@@ -108,19 +108,24 @@ void Overlay::measure_camera(const cv::Mat& video) {
 }
 
 void Overlay::set_adapt_lighting_every(int every_n_frames) {
-  if (every_n_frames <= 0)
-    live_lighting_.reset();
-  else
-    live_lighting_.emplace(camera_, maps_, response_, session_radiometry_, every_n_frames);
+  if (live_lighting_) live_lighting_->restore(*compositor_);
+  live_lighting_.reset();
+  lighting_every_ = every_n_frames;
+  if (every_n_frames > 0)
+    live_lighting_.emplace(camera_, maps_, response_, session_radiometry_,
+                           LiveLightingSettings{.every_n_frames = every_n_frames, .background = live_ || window_});
 }
 
 void Overlay::set_scene(std::shared_ptr<const LoadedScene> scene) {
   context_->make_current();
+  // The lighting measured so far was the old scene's map's: start again.
+  live_lighting_.reset();
   const gl::CompositeFeatures features = compositor_->renderer().features();
   compositor_.reset();  // its GL objects go first
   compositor_ = std::make_unique<Compositor>(std::move(scene), maps_.output, maps_.map_x, maps_.map_y, volume_cache_);
   compositor_->set_features(features);
   compositor_->renderer().set_video_radiometry(radiometry_);
+  set_adapt_lighting_every(lighting_every_);
 }
 
 void Overlay::play_paths(Nanos frame_time) {
@@ -152,13 +157,13 @@ OverlayFrame Overlay::composite(const capture::Frame& frame, const std::optional
   times_.measure += ms_since(measure_start);
   if (live_lighting_ && T_world_camera) {
     const auto t0 = std::chrono::steady_clock::now();
-    out.lighting_scale = live_lighting_->update(compositor_->renderer(), frame.image, *T_world_camera, frame.time);
+    live_lighting_->update(*compositor_, frame.image, *T_world_camera, frame.time);
+    out.lighting_scale = live_lighting_->scale();
+    out.lighting_settled = !live_lighting_->transition();
     times_.lighting += ms_since(t0);
   }
-  // The map's light scaled as the room changed: the objects' radiance scales with it.
   gl::OverlayTimings gt;
-  out.composite =
-      compositor_->composite(frame.image, T_world_camera, exposure_ * exposure_scale_ * out.lighting_scale, &gt);
+  out.composite = compositor_->composite(frame.image, T_world_camera, exposure_ * exposure_scale_, &gt);
   times_.shadows += gt.shadows_ms;
   times_.upload += gt.upload_ms;
   times_.background += gt.background_ms;

@@ -186,7 +186,15 @@ capture::SynthInfo synth_info(const SynthSettings& s) {
 Pose synth_camera_pose(const std::string& path, const glm::dvec3& target, double s, double arc_deg) {
   if (path == "orbit") return orbit_camera_pose(target, s, arc_deg);
   if (path == "still") return orbit_camera_pose(target, 1.0, arc_deg);
-  throw InputError("--path " + path + ": unknown camera path; use orbit or still");
+  if (path == "room") {
+    // Standing back at the room's far side, turning slowly across the object to the far
+    // wall and up, so that the room's lights and window come into view beside the object.
+    const glm::dvec3 eye = target + glm::dvec3(2.7, 1.35 - target.y, 0.5);
+    const double yaw = glm::radians(180.0 + 6.0 - 14.0 * s), pitch = glm::radians(-6.0 + 14.0 * s);
+    const glm::dvec3 look(std::cos(pitch) * std::cos(yaw), std::sin(pitch), -std::cos(pitch) * std::sin(yaw));
+    return look_at(eye, eye + look);
+  }
+  throw InputError("--path " + path + ": unknown camera path; use orbit, still or room");
 }
 
 void synthesize_recording(const SynthSettings& s) {
@@ -202,6 +210,12 @@ void synthesize_recording(const SynthSettings& s) {
   gl::Renderer renderer(pinhole);
   renderer.set_room(scene.room);
   renderer.set_environment(scene.map);
+  std::optional<EnvironmentMap> changed_map;
+  if (s.light_change) {
+    if (s.truth) throw InputError("synth: --truth with a light change is not supported; leave one out");
+    changed_map = changed_environment_map(scene, *s.light_change);
+  }
+  double shown_weight = 0.0;  // of the changed map in the renderer's
 
   // The rig: transmitter on the table, +Z (Polhemus down) along world -Y; the sensor
   // clipped to the camera a few centimetres away, turned 90 degrees.
@@ -266,6 +280,11 @@ void synthesize_recording(const SynthSettings& s) {
   write_synthetic_recording(
       s.out, session, tracker, video, s.frames, s.seed, [&](int k) { return start + frame_period * k; }, true_camera,
       [&](int k, Nanos t, const Pose& T_world_camera, cv::RNG& rng) {
+        if (changed_map) {
+          const double w = s.light_change->weight(nanos_to_seconds(t));
+          if (w != shown_weight) renderer.set_environment(blend_environment_maps(scene.map, *changed_map, w));
+          shown_weight = w;
+        }
         const cv::Mat radiance = renderer.render_room_radiance(pinhole, T_world_camera);
         // The video's own noise, drawn again for the truth, so that only the objects differ.
         cv::RNG same_noise = rng;

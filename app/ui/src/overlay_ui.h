@@ -442,6 +442,11 @@ class OverlayUi {
     bool adapt = overlay_.live_lighting() != nullptr;
     if (ImGui::Checkbox("follow the room's lighting (every 10 frames)", &adapt))
       overlay_.set_adapt_lighting_every(adapt ? 10 : 0), dirty_ = true;
+    if (const auto* lighting = overlay_.live_lighting())
+      ImGui::Text("room %.2fx the map; %d/%d map cells seen, %d re-bakes (%.0f ms)%s", lighting->scale(),
+                  lighting->adapter().measured_cells(),
+                  lighting->adapter().settings().cell_cols * lighting->adapter().settings().cell_rows,
+                  lighting->bakes(), lighting->last_bake_ms(), lighting->transition() ? ", fading in" : "");
     ImGui::Checkbox("proxy wireframe", &debug_.proxy_wireframe);
     ImGui::SameLine();
     ImGui::Checkbox("receivers", &debug_.receivers);

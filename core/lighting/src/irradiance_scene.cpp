@@ -31,4 +31,16 @@ IrradianceVolume scene_irradiance_volume(const LoadedScene& scene, const std::st
   return cached_irradiance_volume(*radiance, m.movement_min, m.movement_max, settings, cache_dir, loaded);
 }
 
+SceneLighting relit_scene_lighting(const LoadedScene& scene, const RoomRadiance& base, const EnvironmentMap& map) {
+  SceneLighting out;
+  out.sh = project_radiance_sh9(map);
+  const std::string& method = scene.manifest.lighting.method;
+  if (method == "sh9") return out;
+  const RoomRadiance relit(base, map);
+  const Scene& m = scene.manifest;
+  out.volume = std::make_shared<const IrradianceVolume>(
+      IrradianceVolume::build(relit, m.movement_min, m.movement_max, scene_volume_settings(m.lighting, method)));
+  return out;
+}
+
 }  // namespace lumar

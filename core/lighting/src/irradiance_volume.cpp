@@ -250,13 +250,18 @@ struct ProbeBuilder {
     if (settings.separate_lights) {
       out.light_visibility.assign(radiance.lights().size(), 0.0f);
       for (std::size_t l = 0; l < radiance.lights().size(); ++l) {
-        double seen = 0.0, total = 0.0;
+        // Weighted by power; a light that is out (relit to black) by solid angle, so that
+        // it keeps its shadow and fades in again like the others.
+        double seen = 0.0, total = 0.0, seen_omega = 0.0, total_omega = 0.0;
         for (int t : radiance.lights()[l].texels) {
-          const double w = luminance(bright[std::size_t(t)].radiance) * bright[std::size_t(t)].solid_angle;
-          total += w;
-          if (visible[std::size_t(t)]) seen += w;
+          const double omega = bright[std::size_t(t)].solid_angle;
+          const double w = luminance(bright[std::size_t(t)].radiance) * omega;
+          total += w, total_omega += omega;
+          if (visible[std::size_t(t)]) seen += w, seen_omega += omega;
         }
-        out.light_visibility[l] = total > 0.0 ? float(seen / total) : 0.0f;
+        out.light_visibility[l] = total > 0.0         ? float(seen / total)
+                                  : total_omega > 0.0 ? float(seen_omega / total_omega)
+                                                      : 0.0f;
       }
     }
 
@@ -538,6 +543,22 @@ double IrradianceVolume::light_shadow_visibility(std::size_t l, const glm::dvec3
   };
   return (1 - fy) * ((1 - fx) * lit(x0, y0) + fx * lit(x0 + 1, y0)) +
          fy * ((1 - fx) * lit(x0, y0 + 1) + fx * lit(x0 + 1, y0 + 1));
+}
+
+IrradianceVolume IrradianceVolume::blend(const IrradianceVolume& from, const IrradianceVolume& to, double t) {
+  if (from.probes.size() != to.probes.size() || from.irradiance_atlas.size() != to.irradiance_atlas.size() ||
+      from.sh.size() != to.sh.size() || from.lights.size() != to.lights.size() || from.distant_ != to.distant_)
+    throw RuntimeError("irradiance volume: cannot blend volumes of different layouts; relight the same room");
+  IrradianceVolume out = to;
+  const float a = float(1.0 - t), b = float(t);
+  for (std::size_t i = 0; i < out.irradiance_atlas.size(); ++i)
+    out.irradiance_atlas[i] = a * from.irradiance_atlas[i] + b * to.irradiance_atlas[i];
+  for (std::size_t i = 0; i < out.sh.size(); ++i) out.sh[i] = a * from.sh[i] + b * to.sh[i];
+  for (std::size_t l = 0; l < out.lights.size(); ++l)
+    out.lights[l].radiance = (1.0 - t) * from.lights[l].radiance + t * to.lights[l].radiance;
+  for (std::size_t i = 0; i < out.light_visibility.size() && i < from.light_visibility.size(); ++i)
+    out.light_visibility[i] = a * from.light_visibility[i] + b * to.light_visibility[i];
+  return out;
 }
 
 glm::dvec3 IrradianceVolume::evaluate(const glm::dvec3& p, const glm::dvec3& normal) const {

@@ -70,7 +70,50 @@ RoomRadiance::RoomRadiance(const EnvironmentMap& map, const Mesh& proxy_world, c
   prepare(map);
 }
 
+RoomRadiance::RoomRadiance(const RoomRadiance& like, const EnvironmentMap& map)
+    : settings_(like.settings_),
+      map_(downsample_environment_map(map, like.settings_.map_height)),
+      proxy_(like.proxy_),
+      bright_(like.bright_),
+      bright_index_(like.bright_index_),
+      lights_(like.lights_),
+      threshold_(like.threshold_) {
+  if (map_.width != like.map_.width || map_.height != like.map_.height)
+    throw InputError("room radiance: a relit map must have the size of the map it relights (" +
+                     std::to_string(like.map_.width) + "x" + std::to_string(like.map_.height) + " after filtering)");
+  if (like.rays_) {
+    rays_ = std::make_unique<RayScene>();
+    rays_->add_static(proxy_);
+    rays_->commit();
+  }
+  for (std::size_t i = 0; i < bright_index_.size(); ++i)
+    if (const int k = bright_index_[i]; k >= 0)
+      bright_[std::size_t(k)].radiance =
+          glm::dvec3(map_.texel(int(i % std::size_t(map_.width)), int(i / std::size_t(map_.width))));
+  for (DominantLight& light : lights_) {
+    light.power = glm::dvec3(0.0);
+    for (int k : light.texels) light.power += bright_[std::size_t(k)].radiance * bright_[std::size_t(k)].solid_angle;
+  }
+  set_fallback();
+}
+
 RoomRadiance::~RoomRadiance() = default;
+
+// Fallback: the mean radiance of everything that is not bright.
+void RoomRadiance::set_fallback() {
+  const int W = map_.width, H = map_.height;
+  glm::dvec3 dim_sum(0.0);
+  double dim_omega = 0.0;
+  for (int r = 0; r < H; ++r) {
+    const double w = latlong_pixel_solid_angle(r, W, H);
+    for (int c = 0; c < W; ++c)
+      if (!is_bright(c, r)) {
+        dim_sum += glm::dvec3(map_.texel(c, r)) * w;
+        dim_omega += w;
+      }
+  }
+  fallback_ = dim_omega > 0.0 ? dim_sum / dim_omega : glm::dvec3(0.0);
+}
 
 void RoomRadiance::prepare(const EnvironmentMap& loaded) {
   if (loaded.width <= 0 || loaded.height <= 0 || loaded.rgb.size() != std::size_t(loaded.width) * loaded.height * 3)
@@ -117,15 +160,7 @@ void RoomRadiance::prepare(const EnvironmentMap& loaded) {
     bright_.push_back(t);
   }
 
-  // Fallback: the mean radiance of everything that is not bright.
-  glm::dvec3 dim_sum(0.0);
-  double dim_omega = 0.0;
-  for (std::size_t i = 0; i < n; ++i)
-    if (bright_index_[i] < 0) {
-      dim_sum += glm::dvec3(map_.texel(int(i % W), int(i / W))) * omega[i];
-      dim_omega += omega[i];
-    }
-  fallback_ = dim_omega > 0.0 ? dim_sum / dim_omega : glm::dvec3(0.0);
+  set_fallback();
 
   // Dominant lights: 8-connected clusters of bright texels (wrapping in azimuth). A
   // cluster too large to be one light (a bright sky around the sun) is split by raising

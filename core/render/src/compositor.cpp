@@ -26,7 +26,7 @@ Compositor::Compositor(std::shared_ptr<const LoadedScene> scene, const CameraInt
   // Spatially varying light: the irradiance volume over the movement box (cached on disk).
   if (const std::string& method = s.manifest.lighting.method; method != "sh9") {
     bool loaded = false;
-    volume_ = std::make_shared<IrradianceVolume>(scene_irradiance_volume(s, method, volume_cache, {}, &loaded));
+    volume_ = std::make_shared<const IrradianceVolume>(scene_irradiance_volume(s, method, volume_cache, {}, &loaded));
     renderer_->set_irradiance_volume(volume_.get());
     spdlog::debug("irradiance volume ({}): {} probes, {}", volume_->settings().describe(), volume_->stats().probes,
                   loaded ? "loaded from the cache" : "built");
@@ -42,6 +42,7 @@ Compositor::Compositor(std::shared_ptr<const LoadedScene> scene, const CameraInt
     const Mesh& mesh = object.model;
     const std::size_t step = std::max<std::size_t>(1, mesh.positions.size() / 200);
     poses_.push_back(object.T_world_model);
+    albedo_.push_back(object.albedo);
     sampled_points_.emplace_back();
     for (std::size_t i = 0; i < mesh.positions.size(); i += step)
       sampled_points_.back().emplace_back(mesh.positions[i]);
@@ -154,12 +155,26 @@ void Compositor::set_object_pose(std::size_t index, const glm::dmat4& T_world_mo
   if (bounce_) bounce_->set_object_pose(int(index), T_world_model);
 }
 
+void Compositor::set_lighting(std::shared_ptr<const IrradianceVolume> volume, const SH9& sh) {
+  if (static_cast<bool>(volume) != static_cast<bool>(volume_))
+    throw RuntimeError("compositor: relit lighting must keep the scene's lighting method");
+  volume_ = std::move(volume);
+  sh_ = sh;
+  renderer_->set_irradiance_volume(volume_.get());
+  for (std::size_t i = 0; i < scene_->objects.size(); ++i) renderer_->set_object_material(int(i), albedo_.at(i), sh_);
+  if (bounce_) {
+    bounce_->relight();
+    shadows_uploaded_ = false;
+  }
+}
+
 void Compositor::set_object_bounce(std::size_t index, bool on) {
   if (index >= poses_.size()) throw RuntimeError("compositor: no object " + std::to_string(index));
   if (bounce_) bounce_->set_object_enabled(int(index), on);
 }
 
 void Compositor::set_object_albedo(std::size_t index, const glm::vec3& albedo) {
+  albedo_.at(index) = albedo;
   renderer_->set_object_material(int(index), albedo, sh_);
   if (bounce_) bounce_->set_object_albedo(int(index), albedo);
 }

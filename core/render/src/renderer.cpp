@@ -605,7 +605,7 @@ cv::Mat Renderer::render_overlay(const cv::Mat& video_bgr8, const std::optional<
   return out;
 }
 
-cv::Mat Renderer::render_room_radiance(const CameraIntrinsics& camera, const Pose& T_world_camera) {
+cv::Mat Renderer::render_room_radiance(const CameraIntrinsics& camera, const Pose& T_world_camera, cv::Mat* map_uv) {
   Impl& r = *impl_;
   if (!camera.is_valid())
     throw InputError("Renderer::render_room_radiance: invalid camera (" + std::to_string(camera.width) + "x" +
@@ -616,19 +616,31 @@ cv::Mat Renderer::render_room_radiance(const CameraIntrinsics& camera, const Pos
     r.room_target = RenderTarget(camera.width, camera.height, GL_RGBA32F, true, "the room radiance");
 
   const glm::mat4 vp = Impl::view_projection(camera.without_distortion(), T_world_camera);
-  r.room_target.begin();
-  glEnable(GL_DEPTH_TEST);
-  glDepthFunc(GL_LESS);
-  glDepthMask(GL_TRUE);
   const GLuint p = r.room_radiance.get();
-  glUseProgram(p);
-  Impl::set_transform(p, glm::mat4(1.0f), glm::mat3(1.0f), vp);
-  glProgramUniform3fv(p, uniform(p, "capture_position"), 1, glm::value_ptr(r.capture_position));
-  glProgramUniformMatrix3fv(p, uniform(p, "map_from_world"), 1, GL_FALSE, glm::value_ptr(r.map_from_world));
-  glBindTextureUnit(shaders::kEnvironmentUnit, r.environment.get());
-  r.room.draw();
-  glDisable(GL_DEPTH_TEST);
-
+  const auto draw = [&](bool map_coordinates) {
+    r.room_target.begin();
+    glEnable(GL_DEPTH_TEST);
+    glDepthFunc(GL_LESS);
+    glDepthMask(GL_TRUE);
+    glUseProgram(p);
+    Impl::set_transform(p, glm::mat4(1.0f), glm::mat3(1.0f), vp);
+    glProgramUniform3fv(p, uniform(p, "capture_position"), 1, glm::value_ptr(r.capture_position));
+    glProgramUniformMatrix3fv(p, uniform(p, "map_from_world"), 1, GL_FALSE, glm::value_ptr(r.map_from_world));
+    glProgramUniform1i(p, uniform(p, "map_coordinates"), map_coordinates ? 1 : 0);
+    glBindTextureUnit(shaders::kEnvironmentUnit, r.environment.get());
+    r.room.draw();
+    glDisable(GL_DEPTH_TEST);
+  };
+  if (map_uv) {
+    draw(true);
+    const cv::Mat rgba =
+        read_float_pixels(camera.width, camera.height, GL_RGBA, CV_32FC4, "Renderer::render_room_radiance");
+    cv::Mat channels[4];
+    cv::split(rgba, channels);
+    cv::merge(channels, 2, *map_uv);
+    map_uv->setTo(cv::Scalar(-1.0f, -1.0f), channels[3] < 0.5f);  // no room there
+  }
+  draw(false);
   return read_float_pixels(camera.width, camera.height, GL_BGR, CV_32FC3, "Renderer::render_room_radiance");
 }
 

@@ -127,6 +127,7 @@ in vec3 world_normal;
 layout(binding = 2) uniform sampler2D environment;  // lat-long, RGB32F, repeat in u, clamp in v
 uniform vec3 capture_position;
 uniform mat3 map_from_world;   // Ry(-azimuth offset)
+uniform bool map_coordinates;  // write the map's (u, v) in [0, 1) instead of its radiance
 out vec4 color;
 void main() {
   // Lat-long convention (latlong.h): d = (sin t cos p, cos t, sin t sin p), u = p / 2pi, v = t / pi.
@@ -135,7 +136,7 @@ void main() {
   if (phi < 0.0) phi += 6.28318530717959;
   float theta = acos(clamp(d.y, -1.0, 1.0));
   vec2 uv = vec2(phi / 6.28318530717959, theta / 3.14159265358979);
-  color = vec4(texture(environment, uv).rgb, 1.0);
+  color = map_coordinates ? vec4(uv, 0.0, 1.0) : vec4(texture(environment, uv).rgb, 1.0);
 }
 )glsl";
 

@@ -45,6 +45,24 @@ glm::vec3 EnvironmentMap::radiance(const glm::dvec3& world) const {
   return glm::vec3(top * (1.0 - fy) + bottom * fy);
 }
 
+EnvironmentMap scale_environment_map(const EnvironmentMap& map, const std::vector<glm::vec3>& ratios, int cols,
+                                     int rows) {
+  if (cols < 1 || rows < 1 || ratios.size() != std::size_t(cols) * std::size_t(rows))
+    throw InputError("environment map: " + std::to_string(ratios.size()) + " cell ratios for a " +
+                     std::to_string(cols) + "x" + std::to_string(rows) + " grid");
+  EnvironmentMap out = map;
+  for (int r = 0; r < map.height; ++r) {
+    const int cell_row = std::min(rows - 1, int((r + 0.5) * rows / map.height));
+    for (int c = 0; c < map.width; ++c) {
+      const glm::vec3& k =
+          ratios[std::size_t(cell_row) * cols + std::size_t(std::min(cols - 1, int((c + 0.5) * cols / map.width)))];
+      float* p = &out.rgb[(std::size_t(r) * map.width + c) * 3];
+      p[0] *= k.r, p[1] *= k.g, p[2] *= k.b;
+    }
+  }
+  return out;
+}
+
 double mean_luminance(const EnvironmentMap& map) {
   double sum = 0, wsum = 0;
   for (int r = 0; r < map.height; ++r) {

@@ -23,8 +23,8 @@ namespace lumar::pipeline {
 
 struct OverlaySettings {
   calib::UndistortedCamera undistortion = calib::UndistortedCamera::SameMatrix;
-  // > 0: every that many frames, compare the video with the map and scale the objects'
-  // lighting as the room gets brighter or darker (live_lighting.h).
+  // > 0: every that many frames, compare the video with the map and follow the room's
+  // light per direction and colour: re-baked, faded in (live_lighting.h).
   int adapt_lighting_every = 0;
   bool window = false;  // a GLFW window to draw into; else a headless EGL context
   std::string window_title = "lumar overlay";
@@ -60,7 +60,8 @@ struct OverlayFrame {
   cv::Mat video;                       // as recorded
   cv::Mat composite;                   // BGR8 output
   std::optional<Pose> T_world_camera;  // the pose used (nullopt: no pose, video only)
-  double lighting_scale = 1.0;         // the map's light as the room measured now (1: unchanged)
+  double lighting_scale = 1.0;         // the room's overall brightness against the map, as measured (1: unchanged)
+  bool lighting_settled = true;        // no re-bake or fade of the objects' lighting under way
 };
 
 class Overlay {
@@ -109,6 +110,7 @@ class Overlay {
   CameraIntrinsics camera_;  // the video's, distorted
   capture::Radiometry session_radiometry_;
   std::optional<LiveLighting> live_lighting_;
+  int lighting_every_ = 0;
   // The camera's noise and blur, measured from the video until they are known.
   void measure_camera(const cv::Mat& video);
   calib::UndistortionMaps maps_;

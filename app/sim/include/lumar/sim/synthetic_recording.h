@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <functional>
+#include <optional>
 #include <opencv2/core.hpp>
 #include <string>
 
@@ -13,6 +14,7 @@
 #include "lumar/base/pose.h"
 #include "lumar/capture/recording_writer.h"
 #include "lumar/capture/session.h"
+#include "lumar/sim/light_change.h"
 #include "lumar/tracking/simulated_tracker.h"
 
 namespace lumar::sim {
@@ -41,6 +43,8 @@ struct SynthSettings {
   bool truth = false;
   std::uint64_t truth_seed = 0;  // the other seed; 0: seed + 1
   int truth_ratio_stride = 4;    // TruthSettings::ratio_stride, in rendered (supersampled) pixels
+  // The room's light changes during the recording (light_change.h); not with truth.
+  std::optional<LightChange> light_change;
 };
 
 // The session's record of the settings every synthetic recording shares ("synth").

@@ -7,6 +7,7 @@
 
 #include "lumar/lighting/irradiance_volume.h"
 #include "lumar/lighting/room_radiance.h"
+#include "lumar/lighting/sh.h"
 #include "lumar/scene/loaded_scene.h"
 
 namespace lumar {
@@ -20,5 +21,17 @@ std::unique_ptr<RoomRadiance> scene_radiance(const LoadedScene& scene, const Rad
 // inputs, else built (and stored, unless use_cache is false). `loaded` says which.
 IrradianceVolume scene_irradiance_volume(const LoadedScene& scene, const std::string& method, bool use_cache = true,
                                          const std::filesystem::path& cache_dir = {}, bool* loaded = nullptr);
+
+// The scene's lighting after the room changed (pipeline/live_lighting.h): its map relit
+// (scale_environment_map), the irradiance volume over the movement box rebuilt from
+// `base` relit to that map, so that it has the layout of the scene's own volume and the
+// two can be blended (IrradianceVolume::blend), and the map's SH9. `base`: the scene's
+// radiance, scene_radiance(scene, scene_volume_settings(...).radiance). No volume when
+// the manifest's lighting.method is "sh9".
+struct SceneLighting {
+  std::shared_ptr<const IrradianceVolume> volume;
+  SH9 sh{};
+};
+SceneLighting relit_scene_lighting(const LoadedScene& scene, const RoomRadiance& base, const EnvironmentMap& map);
 
 }  // namespace lumar

@@ -66,6 +66,11 @@ class IrradianceVolume {
   static IrradianceVolume build(const RoomRadiance& radiance, const glm::dvec3& box_min, const glm::dvec3& box_max,
                                 const VolumeSettings& settings);
 
+  // (1 - t) from + t to: irradiance is linear in the light, so this is the volume of the
+  // blended light. Both must share one layout (built over one box with one settings from
+  // RoomRadiance relit from one another); RuntimeError otherwise.
+  static IrradianceVolume blend(const IrradianceVolume& from, const IrradianceVolume& to, double t);
+
   // Irradiance at world point p with unit normal n.
   glm::dvec3 evaluate(const glm::dvec3& p, const glm::dvec3& n) const;
 

@@ -68,6 +68,12 @@ class RoomRadiance {
   RoomRadiance(const EnvironmentMap& map, const RadianceSettings& settings);
   // Map captured at map.capture_position inside the proxy (world coordinates, metres).
   RoomRadiance(const EnvironmentMap& map, const Mesh& proxy_world, const RadianceSettings& settings);
+  // The same room relit: `like`'s proxy, bright texels and dominant lights (which texels
+  // they are, where they are), with the radiance of `map` (its working-map size: the
+  // full-size map is filtered to it). A lamp that goes out stays a light, of power 0, so
+  // that volumes built before and after the change have the same layout and can be
+  // blended (IrradianceVolume::blend).
+  RoomRadiance(const RoomRadiance& like, const EnvironmentMap& map);
   ~RoomRadiance();
   RoomRadiance(const RoomRadiance&) = delete;
   RoomRadiance& operator=(const RoomRadiance&) = delete;
@@ -108,6 +114,7 @@ class RoomRadiance {
 
  private:
   void prepare(const EnvironmentMap& map);
+  void set_fallback();
   Sample lookup(const glm::dvec3& p, const glm::dvec3& w, bool dim) const;
 
   RadianceSettings settings_;

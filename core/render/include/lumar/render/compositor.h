@@ -75,13 +75,22 @@ class Compositor {
   // The objects' light on the receivers, or nullptr when the scene has no receivers.
   const ObjectBounce* bounce() const { return bounce_.get(); }
 
+  // The room's light changed (pipeline/live_lighting.h): shade the objects, and the light
+  // they reflect, from this volume (nullptr with lighting.method "sh9") and SH9, made by
+  // relit_scene_lighting or blended from two such. The renderer's environment map stays
+  // the captured one, the reference the changes are measured against. The shadow lines
+  // keep the captured map's emitter powers.
+  void set_lighting(std::shared_ptr<const IrradianceVolume> volume, const SH9& sh);
+
   gl::Renderer& renderer() { return *renderer_; }
   const LoadedScene& scene() const { return *scene_; }
+  const std::shared_ptr<const LoadedScene>& shared_scene() const { return scene_; }
   const CameraIntrinsics& output_camera() const { return camera_; }
   const SH9& lighting_sh() const { return sh_; }
   // The irradiance volume that shades the objects per pixel (built for the scene's
   // movement box, or loaded from the cache), or nullptr when lighting.method is "sh9".
   const IrradianceVolume* irradiance_volume() const { return volume_.get(); }
+  const std::shared_ptr<const IrradianceVolume>& irradiance_volume_ptr() const { return volume_; }
   // A few hundred surface points of the virtual objects in their current poses, world
   // coordinates, for checking where they project.
   const std::vector<glm::dvec3>& object_points() const { return object_points_; }
@@ -91,13 +100,14 @@ class Compositor {
   std::shared_ptr<const LoadedScene> scene_;
   SH9 sh_;
   std::unique_ptr<gl::Renderer> renderer_;
-  std::shared_ptr<IrradianceVolume> volume_;  // shared_ptr: incomplete here
+  std::shared_ptr<const IrradianceVolume> volume_;  // shared_ptr: incomplete here
   void build_shadows();
   bool cache_ = true;  // the volume and the shadow lines from the disk cache
   void bake_self_occlusion_once();
   void give_bounce_occlusion();
   std::vector<std::vector<VertexOcclusion>> self_occlusion_;  // per object, once baked
   std::vector<glm::dmat4> poses_;                             // T_world_model per object
+  std::vector<glm::vec3> albedo_;                             // per object
   std::vector<std::vector<glm::dvec3>> sampled_points_;       // per object, model coordinates
   std::vector<glm::dvec3> object_points_;                     // the above, posed
   void pose_object_points();

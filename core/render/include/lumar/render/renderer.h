@@ -120,8 +120,9 @@ class Renderer {
 
   // Linear radiance of the proxy room, textured by projecting the environment map
   // from its capture point, seen by a pinhole `camera` (any size; distortion ignored).
-  // CV_32FC3 BGR; pixels that see no room are 0.
-  cv::Mat render_room_radiance(const CameraIntrinsics& camera, const Pose& T_world_camera);
+  // CV_32FC3 BGR; pixels that see no room are 0. `map_uv` (optional): where each pixel's
+  // radiance comes from in the map, (u, v) / (W, H) in [0, 1] (CV_32FC2), -1 where no room.
+  cv::Mat render_room_radiance(const CameraIntrinsics& camera, const Pose& T_world_camera, cv::Mat* map_uv = nullptr);
 
   // World position of the visible virtual objects after proxy occlusion: CV_32FC4
   // (x, y, z, 1) where covered, (0, 0, 0, 0) elsewhere.

@@ -27,6 +27,12 @@ struct EnvironmentMap {
 // Mean luminance over the sphere, each texel weighted by its solid angle.
 double mean_luminance(const EnvironmentMap& map);
 
+// The map relit by a coarse grid of cells over its own lat-long coordinates: each texel
+// times the RGB ratio of the cell its centre falls in (`ratios`: rows x cols, row-major,
+// row 0 at the top). InputError when the grid and the ratios disagree.
+EnvironmentMap scale_environment_map(const EnvironmentMap& map, const std::vector<glm::vec3>& ratios, int cols,
+                                     int rows);
+
 // Reads an OpenEXR or Radiance HDR file through OpenImageIO (first three channels).
 // Throws InputError naming the file when it is missing, unreadable or not 2:1.
 EnvironmentMap load_environment_map(const std::filesystem::path& path);

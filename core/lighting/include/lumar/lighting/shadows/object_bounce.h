@@ -99,6 +99,8 @@ class ObjectBounce {
   // Recomputes if an object moved, was added or changed since the last call; returns
   // whether it did.
   bool update(const Irradiance& irradiance);
+  // The light on the objects changed (the room was relit): the next update recomputes.
+  void relight() { dirty_ = true; }
 
   // Per receiver, E_bounce / E_without per channel (0 where nothing reaches it).
   const std::vector<glm::vec3>& ratio() const { return ratio_; }
