@@ -28,7 +28,7 @@ struct OverlayOptions {
   bool window = false, no_cache = false, allow_incomplete = false, paused = false;
   std::string save_scene, screenshot, stats_json;
   int max_frames = 0;
-  int adapt_lighting = 0;
+  int adapt_lighting = 0, adapt_lighting_cells = 32;
   pipeline::LiveOverlayOptions live;  // --source and what only the live path reads
 };
 
@@ -38,6 +38,7 @@ pipeline::OverlaySettings overlay_settings(const OverlayOptions& o, bool window)
                    : o.undistort == "keep" ? calib::UndistortedCamera::KeepAll
                                            : calib::UndistortedCamera::SameMatrix;
   s.adapt_lighting_every = o.adapt_lighting;
+  s.adapt_lighting_cells = o.adapt_lighting_cells;
   s.window = window;
   s.volume_cache = !o.no_cache;
   apply_composite_features(o.without, o.blur_sigma, s);
@@ -202,8 +203,14 @@ void register_overlay(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option(
          "--adapt-lighting", o->adapt_lighting,
-         "Every N frames, compare the video with the map and follow the room getting brighter or darker (0 = off)")
+         "Every N frames, compare the video with the map and follow the room's light per direction and colour: a "
+         "lamp going out, a window turning warmer (0 = off; docs/envmap.md)")
       ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  cmd->add_option("--adapt-lighting-cells", o->adapt_lighting_cells,
+                  "--adapt-lighting: the map's directions in this many columns of cells, half as many rows "
+                  "(docs/lighting_change_error_vs_time.png)")
+      ->check(CLI::Range(1, 256))
       ->capture_default_str();
   cmd->add_flag("--window", o->window,
                 "Show the result in a window (needs a display): a recording's with panels to play it and to place, "

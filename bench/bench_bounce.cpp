@@ -198,14 +198,7 @@ int main(int argc, char** argv) {
       "ms/frame; reference {:.0f} ms (all cores)",
       BounceSettings{}.clusters, def ? def->time_ms : 0.0, errors.at(fmt::format("box/{}", BounceSettings{}.clusters)),
       fig ? fig->time_ms : 0.0, reference_ms);
-  if (report.entries.size() == cluster_counts.size() + 1) {
-    report.save(bench::results_dir());
-    std::filesystem::copy_file(bench::results_dir() / "bounce_error_vs_time.png",
-                               kSource / "docs/bounce_error_vs_time.png",
-                               std::filesystem::copy_options::overwrite_existing);
-  } else {
-    fmt::print("a filtered run: the chart and JSON are left as they are\n");
-  }
+  report.publish(cluster_counts.size() + 1);
   fmt::print("{}\n", report.note);
   return 0;
 }

@@ -157,6 +157,17 @@ void BenchReport::write_chart(const std::filesystem::path& file) const {
   calib::write_image_atomically(file, img);
 }
 
+void BenchReport::publish(std::size_t expected_entries) const {
+  if (entries.size() != expected_entries) {
+    std::printf("a filtered run: the chart and JSON are left as they are\n");
+    return;
+  }
+  save(results_dir());
+  std::filesystem::copy_file(results_dir() / (name + ".png"),
+                             std::filesystem::path(LUMAR_SOURCE_DIR) / "docs" / (name + ".png"),
+                             std::filesystem::copy_options::overwrite_existing);
+}
+
 void BenchReport::save(const std::filesystem::path& dir) const {
   std::filesystem::create_directories(dir);
   write_json(dir / (name + ".json"));

@@ -39,6 +39,10 @@ struct BenchReport {
   void write_chart(const std::filesystem::path& file) const;
   // Writes <dir>/<name>.json and <dir>/<name>.png and prints a table.
   void save(const std::filesystem::path& dir) const;
+  // A chart the docs show: when the run measured `expected_entries` (not a filtered run),
+  // saves into results_dir() and copies the PNG to docs/<name>.png in the source tree;
+  // otherwise leaves both as they are and says so.
+  void publish(std::size_t expected_entries) const;
 };
 
 // Where results go: $LUMAR_BENCH_OUT, else bench/results in the source tree.

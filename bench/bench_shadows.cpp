@@ -326,14 +326,8 @@ int main(int argc, char** argv) {
       s.receivers.positions.size(), built.at(1).precompute_ms, big.precompute_ms);
   if (quick) {
     fmt::print("LUMAR_SHADOW_BENCH_QUICK: no reference, so the chart and JSON are left as they are\n");
-  } else if (report.entries.size() != errors.size()) {
-    fmt::print("a filtered run: the chart and JSON are left as they are\n");
   } else {
-    report.save(bench::results_dir());
-    // The chart also lives beside the shadow docs.
-    std::filesystem::copy_file(bench::results_dir() / "shadow_error_vs_time.png",
-                               std::filesystem::path(LUMAR_SOURCE_DIR) / "docs/shadow_error_vs_time.png",
-                               std::filesystem::copy_options::overwrite_existing);
+    report.publish(errors.size());  // the chart also lives beside the shadow docs
   }
   fmt::print("{}\n", report.note);
   for (int k : samples)

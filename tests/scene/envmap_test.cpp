@@ -208,5 +208,27 @@ TEST(EnvironmentMap, BadFilesThrowInputErrorNamingTheFile) {
   expect_input_error_naming("/dev/zero", "is a device or a pipe");
 }
 
+TEST(EnvironmentMap, ScaledByCellsOfItsOwnDirections) {
+  // A grey 16 x 8 map, a 4 x 2 grid: each texel takes the factor of the cell its centre is in.
+  EnvironmentMap map;
+  map.width = 16, map.height = 8;
+  map.rgb.assign(16 * 8 * 3, 1.0f);
+  map.azimuth_offset_deg = 90.0;  // cells are in the map's own directions, not the world's
+  MapCellScale scale{4, 2, std::vector<glm::vec3>(8, glm::vec3(1.0f))};
+  scale.rgb[1 * 4 + 2] = {2.0f, 1.0f, 0.5f};  // lower row, third column
+  const EnvironmentMap out = scale_environment_map(map, scale);
+  for (int r = 0; r < 8; ++r)
+    for (int c = 0; c < 16; ++c) {
+      const glm::vec3 want = (r >= 4 && c >= 8 && c < 12) ? glm::vec3(2.0f, 1.0f, 0.5f) : glm::vec3(1.0f);
+      ASSERT_EQ(out.texel(c, r), want) << c << "," << r;
+      // at() finds the same cell from the texel's direction.
+      ASSERT_EQ(scale.at(latlong_pixel_direction(c, r, 16, 8)), want) << c << "," << r;
+    }
+  const MapCellScale half =
+      MapCellScale::blend(MapCellScale{4, 2, std::vector<glm::vec3>(8, glm::vec3(1.0f))}, scale, 0.5);
+  EXPECT_EQ(half.rgb[6], glm::vec3(1.5f, 1.0f, 0.75f));
+  EXPECT_THROW(scale_environment_map(map, MapCellScale{4, 2, std::vector<glm::vec3>(7, glm::vec3(1.0f))}), InputError);
+}
+
 }  // namespace
 }  // namespace lumar

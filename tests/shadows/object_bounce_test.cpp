@@ -128,6 +128,61 @@ TEST(ObjectBounce, SphereOnAPlaneSendsItsAlbedoTimesWhatItBlocks) {
   }
 }
 
+TEST(ObjectBounce, SpheresUnderAUniformSkyLightEachOther) {
+  // Each sphere is lit by E = π, so its radiance is its albedo ρ, and a point that sees
+  // the whole of a sphere of radius R at distance D, at an angle θ from its normal, gets
+  // E = ρ π (R/D)² cos θ: the other sphere's vertices facing it must get that, those
+  // turned away nothing.
+  const std::vector<glm::vec3> positions{{50, 0, 0}}, normals{{0, 1, 0}}, without{glm::vec3(float(kPi))};
+  const auto uniform = [](const glm::vec3&, const glm::vec3&) { return glm::vec3(float(kPi)); };
+  const glm::vec3 rho_a(0.8f, 0.4f, 0.2f), rho_b(0.5f);
+  const double Ra = 1.0, Rb = 0.3;
+  const glm::dvec3 ca(0.0), cb(2.5, 0.0, 0.0);
+  const Mesh sphere_a = test::make_sphere({0, 0, 0}, float(Ra), 96, 48),
+             sphere_b = test::make_sphere({0, 0, 0}, float(Rb), 48, 24);
+  ObjectBounce bounce(positions, normals, without);
+  const int a = bounce.add_object(sphere_a, rho_a, translation(ca.x, ca.y, ca.z));
+  ASSERT_TRUE(bounce.update(uniform));
+  for (const glm::vec3& e : bounce.object_bounce(a))
+    ASSERT_EQ(e, glm::vec3(0.0f)) << "one object lights nothing of its own";
+  const int b = bounce.add_object(sphere_b, rho_b, translation(cb.x, cb.y, cb.z));
+  ASSERT_TRUE(bounce.update(uniform));
+
+  // Onto `to` (posed at `at`) from a sphere of radius R and albedo rho at `from`.
+  const auto check = [&](int to, const Mesh& mesh, const glm::dvec3& at, const glm::dvec3& from, double R,
+                         const glm::vec3& rho) {
+    double worst = 0;
+    int facing = 0, away = 0;
+    for (std::size_t v = 0; v < mesh.positions.size(); ++v) {
+      const glm::dvec3 x = glm::dvec3(mesh.positions[v]) + at, n = glm::normalize(glm::dvec3(mesh.normals[v]));
+      const double D = glm::length(from - x), cos_theta = glm::dot(n, (from - x) / D);
+      const glm::vec3 got = bounce.object_bounce(to)[v];
+      if (cos_theta >= R / D) {
+        for (int c = 0; c < 3; ++c) {
+          const double want = rho[c] * kPi * (R / D) * (R / D) * cos_theta;
+          worst = std::max(worst, std::abs(got[c] - want) / want);
+        }
+        ++facing;
+      } else if (cos_theta <= -R / D) {
+        EXPECT_EQ(got, glm::vec3(0.0f)) << "vertex " << v << " is turned away";
+        ++away;
+      }
+    }
+    std::printf("%d vertices facing the other sphere: worst relative error %.4f; %d turned away get 0\n", facing, worst,
+                away);
+    EXPECT_GT(facing, 20);
+    EXPECT_GT(away, 20);
+    EXPECT_LT(worst, 0.03);
+  };
+  check(b, sphere_b, cb, ca, Ra, rho_a);
+  check(a, sphere_a, ca, cb, Rb, rho_b);
+  // A sphere that does not reflect (the manifest's "bounce": false) lights nothing.
+  bounce.set_object_enabled(b, false);
+  bounce.update(uniform);
+  for (const glm::vec3& e : bounce.object_bounce(a)) ASSERT_EQ(e, glm::vec3(0.0f));
+  EXPECT_THROW(bounce.object_bounce(7), RuntimeError);
+}
+
 TEST(ObjectBounce, FollowsPoseAlbedoAndSwitch) {
   const std::vector<glm::vec3> positions{{1, 0, 0}}, normals{{0, 1, 0}}, without{glm::vec3(float(kPi))};
   ObjectBounce bounce(positions, normals, without);

@@ -247,6 +247,32 @@ TEST(ShadowOverlay, ARedBoxTintsTheFloorBesideIt) {
               redder_pixels.unexplained);
   EXPECT_GT(redder_pixels.changed, 100);
   EXPECT_EQ(redder_pixels.unexplained, 0);
+
+  // The figurine beside the box is tinted too (object onto object): its pixels gain red,
+  // far more than green, and only where the CPU says the box's light reaches it.
+  const auto& received = compositor.bounce()->object_bounce(0);
+  const float most = std::max_element(received.begin(), received.end(), [](const glm::vec3& a, const glm::vec3& b) {
+                       return a.r < b.r;
+                     })->r;
+  ASSERT_GT(most, 0.0f);
+  const cv::Mat figurine = compositor.renderer().render_object_world_positions(pose);
+  double red_gain = 0, green_gain = 0;
+  int tinted = 0;
+  for (int v = 0; v < camera.height; ++v)
+    for (int u = 0; u < camera.width; ++u) {
+      const cv::Vec4f w = figurine.at<cv::Vec4f>(v, u);
+      if (w[3] < 0.5f || w[0] > 0.17f) continue;  // the figurine's pixels (the box stands at x > 0.17 m)
+      const cv::Vec3f a = lin_on.at<cv::Vec3f>(v, u), b = lin_off.at<cv::Vec3f>(v, u);
+      red_gain += a[2] - b[2], green_gain += a[1] - b[1];
+      tinted += a[2] - b[2] > 0.004f;
+    }
+  std::printf(
+      "figurine: %d pixels redder; red gained %.2f, green %.2f (linear, summed); most red bounce %.3f; the bounce "
+      "update took %.1f ms, %.1f ms of it onto each other\n",
+      tinted, red_gain, green_gain, most, compositor.bounce()->stats().ms,
+      compositor.bounce()->stats().onto_objects_ms);
+  EXPECT_GT(tinted, 50);
+  EXPECT_GT(red_gain, 5.0 * std::abs(green_gain));
 }
 
 // Two figurines, one hovering above and beside the other: where the CPU says the upper
@@ -260,8 +286,9 @@ TEST(ShadowOverlay, ObjectsShadowEachOther) {
   scene.objects.push_back(upper);
   Compositor compositor(std::make_shared<const LoadedScene>(scene), camera, cv::Mat(), cv::Mat());
   ASSERT_NE(compositor.object_shadows(), nullptr);
-  // Whole pixels, so that a pixel shows the one triangle found at its centre.
-  compositor.set_features({.antialiasing = false});
+  // Whole pixels, so that a pixel shows the one triangle found at its centre; no bounce,
+  // so that the frames differ by the shadows alone.
+  compositor.set_features({.antialiasing = false, .bounce = false});
   const double exposure = 0.66;
   const cv::Mat video = room_video(compositor, camera, pose, exposure);
   compositor.set_shadows_enabled(true);

@@ -14,8 +14,10 @@ namespace {
 constexpr int kShrink = 4;
 constexpr int kClipCode = 250;  // video codes at or above are taken as clipped
 
-calib::LightingAdapterSettings adapter_settings(const calib::CameraResponse& response, double exposure) {
+calib::LightingAdapterSettings adapter_settings(const calib::CameraResponse& response, double exposure, int cols) {
   calib::LightingAdapterSettings s;
+  s.cell_cols = std::max(1, cols);
+  s.cell_rows = std::max(1, cols / 2);
   // Near-clipped video says only "at least this bright".
   s.max_observed = response(1, kClipCode) / exposure;
   return s;
@@ -30,7 +32,7 @@ LiveLighting::LiveLighting(const CameraIntrinsics& video_camera, const calib::Un
       map_y_(maps.map_y),
       response_(response),
       exposure_(radiometry.exposure),
-      adapter_(adapter_settings(response, radiometry.exposure)) {
+      adapter_(adapter_settings(response, radiometry.exposure, settings.cell_cols)) {
   settings_.every_n_frames = std::max(1, settings.every_n_frames);
   baked_version_ = adapter_.version();
   small_camera_ = maps.output.without_distortion();
@@ -59,14 +61,13 @@ LiveLighting::Baked LiveLighting::bake(const std::shared_ptr<const LoadedScene>&
   if (!base_)
     base_ = scene_radiance(*scene,
                            scene_volume_settings(scene->manifest.lighting, scene->manifest.lighting.method).radiance);
-  std::vector<glm::vec3> ratios(ratios_bgr.total());
-  for (std::size_t k = 0; k < ratios.size(); ++k) {
+  MapCellScale scale{ratios_bgr.cols, ratios_bgr.rows, std::vector<glm::vec3>(ratios_bgr.total())};
+  for (std::size_t k = 0; k < scale.rgb.size(); ++k) {
     const cv::Vec3d v = ratios_bgr.at<cv::Vec3d>(int(k));
-    ratios[k] = glm::vec3(float(v[2]), float(v[1]), float(v[0]));
+    scale.rgb[k] = glm::vec3(float(v[2]), float(v[1]), float(v[0]));
   }
-  const EnvironmentMap map = scale_environment_map(scene->map, ratios, ratios_bgr.cols, ratios_bgr.rows);
   Baked out;
-  out.lighting = relit_scene_lighting(*scene, *base_, map);
+  out.lighting = relit_scene_lighting(*scene, *base_, scale);
   out.ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   return out;
 }
@@ -81,7 +82,7 @@ void LiveLighting::start_fade(Baked baked, Nanos time) {
 }
 
 void LiveLighting::restore(Compositor& compositor) const {
-  if (original_.volume || bakes_ > 0) compositor.set_lighting(original_.volume, original_.sh);
+  if (bakes_ > 0) compositor.set_lighting(original_);
 }
 
 void LiveLighting::update(Compositor& compositor, const cv::Mat& video_bgr8, const Pose& T_world_camera, Nanos time) {
@@ -90,6 +91,9 @@ void LiveLighting::update(Compositor& compositor, const cv::Mat& video_bgr8, con
     scene_ = compositor.shared_scene();
     original_.volume = compositor.irradiance_volume_ptr();
     original_.sh = compositor.lighting_sh();
+    const auto& s = adapter_.settings();
+    original_.scale = MapCellScale{s.cell_cols, s.cell_rows,
+                                   std::vector<glm::vec3>(std::size_t(s.cell_cols) * s.cell_rows, glm::vec3(1.0f))};
     from_ = original_;
   }
   if (calls_++ % settings_.every_n_frames == 0) {
@@ -133,21 +137,17 @@ void LiveLighting::update(Compositor& compositor, const cv::Mat& video_bgr8, con
     if (!settings_.background) start_fade(pending_.get(), time);
   }
   if (fading_) {
+    const auto t0 = std::chrono::steady_clock::now();
     const double t = settings_.fade_s > 0 ? nanos_to_seconds(time - fade_start_) / settings_.fade_s : 1.0;
     if (t >= 1.0) {
-      compositor.set_lighting(to_.volume, to_.sh);
+      compositor.set_lighting(to_);
       from_ = to_;
       fading_ = false;
     } else {
-      const double w = std::max(0.0, t);
-      SH9 sh;
-      for (std::size_t i = 0; i < sh.coefficients.size(); ++i)
-        sh.coefficients[i] = (1.0 - w) * from_.sh.coefficients[i] + w * to_.sh.coefficients[i];
-      compositor.set_lighting(from_.volume ? std::make_shared<const IrradianceVolume>(
-                                                 IrradianceVolume::blend(*from_.volume, *to_.volume, w))
-                                           : nullptr,
-                              sh);
+      compositor.set_lighting(SceneLighting::blend(from_, to_, std::max(0.0, t)));
     }
+    worst_fade_step_ms_ = std::max(
+        worst_fade_step_ms_, std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
   }
 }
 

@@ -67,6 +67,7 @@ Overlay::Overlay(std::shared_ptr<const LoadedScene> scene, const CameraIntrinsic
   if (settings.blur_sigma_px >= 0) radiometry_.blur_sigma_px = settings.blur_sigma_px, blur_known_ = true;
   compositor_->set_features(settings.features);
   compositor_->renderer().set_video_radiometry(radiometry_);
+  lighting_cells_ = settings.adapt_lighting_cells;
   set_adapt_lighting_every(settings.adapt_lighting_every);
 }
 
@@ -112,8 +113,10 @@ void Overlay::set_adapt_lighting_every(int every_n_frames) {
   live_lighting_.reset();
   lighting_every_ = every_n_frames;
   if (every_n_frames > 0)
-    live_lighting_.emplace(camera_, maps_, response_, session_radiometry_,
-                           LiveLightingSettings{.every_n_frames = every_n_frames, .background = live_ || window_});
+    live_lighting_.emplace(
+        camera_, maps_, response_, session_radiometry_,
+        LiveLightingSettings{
+            .every_n_frames = every_n_frames, .cell_cols = lighting_cells_, .background = live_ || window_});
 }
 
 void Overlay::set_scene(std::shared_ptr<const LoadedScene> scene) {

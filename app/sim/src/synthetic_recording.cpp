@@ -197,6 +197,30 @@ Pose synth_camera_pose(const std::string& path, const glm::dvec3& target, double
   throw InputError("--path " + path + ": unknown camera path; use orbit, still or room");
 }
 
+std::vector<SynthSettings> sample_room_light_changes(const std::filesystem::path& scene, const CameraIntrinsics& camera,
+                                                     const std::filesystem::path& out_dir) {
+  SynthSettings base;
+  base.scene = scene;
+  base.camera = camera;
+  base.fps = 24;
+  base.supersample = 1;
+  base.path = "room";
+  SynthSettings lamp = base;
+  lamp.out = out_dir / "lamp-off";
+  lamp.frames = 120;
+  lamp.light_change = LightChange{
+      .region = {{-1.45, 2.9, 0.15}, {-0.95, 3.1, 0.45}}, .scale = glm::dvec3(0.0), .brighter_than = 5.0, .at_s = 2.5};
+  SynthSettings window = base;
+  window.out = out_dir / "warmer-window";
+  window.frames = 96;
+  window.exposure = 0.065;
+  window.light_change = LightChange{.region = {{-3.1, 0.3, -2.5}, {-2.9, 2.75, -0.2}},
+                                    .scale = glm::dvec3(1.5, 1.0, 0.5),
+                                    .at_s = 1.5,
+                                    .ramp_s = 0.5};
+  return {lamp, window};
+}
+
 void synthesize_recording(const SynthSettings& s) {
   if (s.frames < 2) throw InputError("--frames: need at least 2 frames");
   if (s.fps <= 0) throw InputError("--fps: must be positive");

@@ -31,8 +31,20 @@ IrradianceVolume scene_irradiance_volume(const LoadedScene& scene, const std::st
   return cached_irradiance_volume(*radiance, m.movement_min, m.movement_max, settings, cache_dir, loaded);
 }
 
-SceneLighting relit_scene_lighting(const LoadedScene& scene, const RoomRadiance& base, const EnvironmentMap& map) {
+SceneLighting SceneLighting::blend(const SceneLighting& a, const SceneLighting& b, double w) {
   SceneLighting out;
+  out.scale = MapCellScale::blend(a.scale, b.scale, w);
+  if (a.volume && b.volume)
+    out.volume = std::make_shared<const IrradianceVolume>(IrradianceVolume::blend(*a.volume, *b.volume, w));
+  for (std::size_t i = 0; i < out.sh.coefficients.size(); ++i)
+    out.sh.coefficients[i] = (1.0 - w) * a.sh.coefficients[i] + w * b.sh.coefficients[i];
+  return out;
+}
+
+SceneLighting relit_scene_lighting(const LoadedScene& scene, const RoomRadiance& base, const MapCellScale& scale) {
+  SceneLighting out;
+  out.scale = scale;
+  const EnvironmentMap map = scale_environment_map(scene.map, scale);
   out.sh = project_radiance_sh9(map);
   const std::string& method = scene.manifest.lighting.method;
   if (method == "sh9") return out;

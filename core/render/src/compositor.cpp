@@ -142,6 +142,7 @@ void Compositor::set_shadow_quality(const ShadowQuality& quality) {
   object_shadows_.reset();
   bounce_.reset();
   build_shadows();
+  relight_shadows();
   shadows_uploaded_ = object_shadows_uploaded_ = false;
 }
 
@@ -155,17 +156,31 @@ void Compositor::set_object_pose(std::size_t index, const glm::dmat4& T_world_mo
   if (bounce_) bounce_->set_object_pose(int(index), T_world_model);
 }
 
-void Compositor::set_lighting(std::shared_ptr<const IrradianceVolume> volume, const SH9& sh) {
-  if (static_cast<bool>(volume) != static_cast<bool>(volume_))
+void Compositor::set_lighting(const SceneLighting& lighting) {
+  if (static_cast<bool>(lighting.volume) != static_cast<bool>(volume_))
     throw RuntimeError("compositor: relit lighting must keep the scene's lighting method");
-  volume_ = std::move(volume);
-  sh_ = sh;
+  volume_ = lighting.volume;
+  sh_ = lighting.sh;
   renderer_->set_irradiance_volume(volume_.get());
   for (std::size_t i = 0; i < scene_->objects.size(); ++i) renderer_->set_object_material(int(i), albedo_.at(i), sh_);
-  if (bounce_) {
-    bounce_->relight();
-    shadows_uploaded_ = false;
-  }
+  light_scale_ = lighting.scale;
+  relight_shadows();
+}
+
+// The shadow lines' emitters scaled by the room's change (set_lighting), each sample by
+// the cell its direction from the map's capture point falls in.
+void Compositor::relight_shadows() {
+  if (!shadows_ || light_scale_.rgb.size() <= 1) return;
+  const ShadowLines& lines = shadows_->lines();
+  const EnvironmentMap& map = scene_->map;
+  std::vector<glm::vec3> sample_scale;
+  sample_scale.reserve(lines.samples.size());
+  for (const EmitterPoint& e : lines.samples)  // distant: the position is the direction
+    sample_scale.push_back(light_scale_.at(
+        map.map_direction(lines.distant ? glm::dvec3(e.position) : glm::dvec3(e.position) - map.capture_position)));
+  shadows_->relight(sample_scale);
+  if (bounce_) bounce_->relight(shadows_->lines().unshadowed);
+  shadows_uploaded_ = false;
 }
 
 void Compositor::set_object_bounce(std::size_t index, bool on) {
@@ -179,12 +194,24 @@ void Compositor::set_object_albedo(std::size_t index, const glm::vec3& albedo) {
   if (bounce_) bounce_->set_object_albedo(int(index), albedo);
 }
 
+// The light the objects reflect onto each other (with two or more), or none.
+void Compositor::upload_object_bounce(bool on) {
+  if (!bounce_ || scene_->objects.size() < 2) return;
+  for (std::size_t i = 0; i < scene_->objects.size(); ++i) {
+    const std::vector<glm::vec3>& received = bounce_->object_bounce(int(i));
+    renderer_->set_object_bounce_light(int(i),
+                                       on ? received : std::vector<glm::vec3>(received.size(), glm::vec3(0.0f)));
+  }
+}
+
 void Compositor::set_shadows_enabled(bool on, bool on_each_other) {
   if (on != shadows_enabled_) {
     shadows_enabled_ = on;
     shadows_uploaded_ = false;
-    if (shadows_ && !on)
+    if (shadows_ && !on) {
       renderer_->set_receiver_attenuation(std::vector<glm::vec3>(shadows_->attenuation().size(), glm::vec3(1.0f)));
+      upload_object_bounce(false);
+    }
   }
   if (on_each_other != object_shadows_enabled_) {
     object_shadows_enabled_ = on_each_other;
@@ -206,6 +233,7 @@ cv::Mat Compositor::composite(const cv::Mat& video_bgr8, const std::optional<Pos
     if (changed || !shadows_uploaded_) {
       renderer_->set_receiver_attenuation(bounce ? with_bounce(shadows_->attenuation(), *bounce_)
                                                  : shadows_->attenuation());
+      upload_object_bounce(bounce);
       shadows_uploaded_ = true;
     }
   }

@@ -56,6 +56,10 @@ void GpuMesh::set_self_occlusion(std::span<const glm::vec4> occlusion) {
   update_attribute(occlusion_, 3, 4, occlusion.data(), occlusion.size(), "self-occlusion");
 }
 
+void GpuMesh::set_bounce_light(std::span<const glm::vec3> irradiance) {
+  update_attribute(bounce_, 4, 3, irradiance.data(), irradiance.size(), "bounce light");
+}
+
 void GpuMesh::draw() const {
   if (empty()) return;
   glBindVertexArray(vertex_array_.get());

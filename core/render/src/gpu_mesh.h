@@ -1,7 +1,8 @@
 #pragma once
 // A Mesh in GPU buffers: positions at attribute 0, normals (if any) at attribute 1, and
-// optionally per-vertex values that change: a vec3 at attribute 2 (set_light_attenuation)
-// and a vec4 at attribute 3 (set_self_occlusion). Unset, attribute 3 reads (0, 0, 0, 1).
+// optionally per-vertex values that change: a vec3 at attribute 2 (set_light_attenuation),
+// a vec4 at attribute 3 (set_self_occlusion) and a vec3 at attribute 4 (set_bounce_light).
+// Unset, attributes 3 and 4 read (0, 0, 0, 1).
 #include <glm/glm.hpp>
 #include <span>
 
@@ -24,12 +25,14 @@ class GpuMesh {
   // Per-vertex bent normal (xyz, model space) and open share (w) of the object's own
   // occlusion (lighting/self_occlusion.h). Same rules as set_light_attenuation.
   void set_self_occlusion(std::span<const glm::vec4> occlusion);
+  // Per-vertex irradiance the other objects reflect onto it (attribute 4). Same rules.
+  void set_bounce_light(std::span<const glm::vec3> irradiance);
   void draw() const;  // binds its vertex array and draws the triangles
 
  private:
   void update_attribute(GlName& buffer, GLuint attribute, int components, const void* data, std::size_t count,
                         const char* what);
-  GlName vertex_array_, positions_, normals_, indices_, attenuation_, occlusion_;
+  GlName vertex_array_, positions_, normals_, indices_, attenuation_, occlusion_, bounce_;
   GLsizei index_count_ = 0;
   std::size_t vertex_count_ = 0;
 };

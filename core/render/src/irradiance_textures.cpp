@@ -182,11 +182,11 @@ vec3 volume_irradiance(vec3 p, vec3 n) {
 }
 )glsl";
 
-IrradianceTextures::BufferTexture IrradianceTextures::buffer_texture(GLenum format, const void* data,
-                                                                     std::size_t bytes) {
+IrradianceTextures::BufferTexture IrradianceTextures::buffer_texture(GLenum format, const void* data, std::size_t bytes,
+                                                                     GLbitfield flags) {
   BufferTexture t;
   static const float zero[4] = {0, 0, 0, 0};
-  t.buffer = create_buffer(bytes ? data : zero, bytes ? bytes : sizeof(zero));
+  t.buffer = create_buffer(bytes ? data : zero, bytes ? bytes : sizeof(zero), flags);
   GLuint id = 0;
   glCreateTextures(GL_TEXTURE_BUFFER, 1, &id);
   t.texture = GlName(id, [](GLuint n) { glDeleteTextures(1, &n); });
@@ -219,11 +219,12 @@ IrradianceTextures::IrradianceTextures(const IrradianceVolume& v) {
   std::vector<float> sh_rgba(v.sh.size() / 3 * 4, 0.0f);  // one RGBA texel per coefficient: 9 fetches, not 27
   for (std::size_t i = 0; i < v.sh.size() / 3; ++i)
     for (int c = 0; c < 3; ++c) sh_rgba[i * 4 + std::size_t(c)] = v.sh[i * 3 + std::size_t(c)];
-  sh_ = buffer_texture(GL_RGBA32F, sh_rgba.data(), sh_rgba.size() * sizeof(float));
+  // The light's own (SH, visibility) may be updated in place when the room is relit.
+  sh_ = buffer_texture(GL_RGBA32F, sh_rgba.data(), sh_rgba.size() * sizeof(float), GL_DYNAMIC_STORAGE_BIT);
   std::vector<float> visibility_and_shadows = v.light_visibility;
   visibility_and_shadows.insert(visibility_and_shadows.end(), v.light_shadow.begin(), v.light_shadow.end());
-  light_visibility_ =
-      buffer_texture(GL_R32F, visibility_and_shadows.data(), visibility_and_shadows.size() * sizeof(float));
+  light_visibility_ = buffer_texture(GL_R32F, visibility_and_shadows.data(),
+                                     visibility_and_shadows.size() * sizeof(float), GL_DYNAMIC_STORAGE_BIT);
   shadow_offset_ = int(v.light_visibility.size());
   const bool has_irradiance = !v.irradiance_atlas.empty();
   irradiance_ = atlas(GL_RGB32F, GL_RGB, has_irradiance ? v.atlas_width(v.irradiance_n) : 1,
@@ -235,6 +236,10 @@ IrradianceTextures::IrradianceTextures(const IrradianceVolume& v) {
   copy_.capture_position = v.capture_position, copy_.irradiance_n = v.irradiance_n, copy_.depth_n = v.depth_n;
   copy_.atlas_columns = v.atlas_columns, copy_.normal_bias = v.normal_bias, copy_.lights = v.lights;
   copy_.shadow_n = v.shadow_n;
+  irradiance_width_ = has_irradiance ? v.atlas_width(v.irradiance_n) : 0;
+  irradiance_height_ = has_irradiance ? v.atlas_height(v.irradiance_n) : 0;
+  probe_count_ = v.probes.size();
+  sh_floats_ = v.sh.size();
   storage_ = int(v.settings().storage);
   visibility_ = v.settings().visibility;
   distant_ = v.distant();
@@ -242,6 +247,37 @@ IrradianceTextures::IrradianceTextures(const IrradianceVolume& v) {
             v.light_shadow.size() + v.irradiance_atlas.size() + v.depth_atlas.size()) *
            4;
   check_gl_errors("IrradianceTextures");
+}
+
+bool IrradianceTextures::update_lighting(const IrradianceVolume& v) {
+  const bool has_irradiance = !v.irradiance_atlas.empty();
+  if (v.probes.size() != probe_count_ || v.sh.size() != sh_floats_ || v.lights.size() != copy_.lights.size() ||
+      int(v.light_visibility.size()) != shadow_offset_ ||
+      (has_irradiance ? v.atlas_width(v.irradiance_n) : 0) != irradiance_width_ ||
+      (has_irradiance ? v.atlas_height(v.irradiance_n) : 0) != irradiance_height_ || v.box_min != copy_.box_min ||
+      v.cell_size != copy_.cell_size || v.cells != copy_.cells || v.capture_position != copy_.capture_position)
+    return false;
+  for (std::size_t l = 0; l < v.lights.size(); ++l)
+    if (v.lights[l].position != copy_.lights[l].position || v.lights[l].direction != copy_.lights[l].direction)
+      return false;
+  if (!v.sh.empty()) {
+    std::vector<float> sh_rgba(v.sh.size() / 3 * 4, 0.0f);
+    for (std::size_t i = 0; i < v.sh.size() / 3; ++i)
+      for (int c = 0; c < 3; ++c) sh_rgba[i * 4 + std::size_t(c)] = v.sh[i * 3 + std::size_t(c)];
+    glNamedBufferSubData(sh_.buffer.get(), 0, GLsizeiptr(sh_rgba.size() * sizeof(float)), sh_rgba.data());
+  }
+  if (!v.light_visibility.empty())
+    glNamedBufferSubData(light_visibility_.buffer.get(), 0, GLsizeiptr(v.light_visibility.size() * sizeof(float)),
+                         v.light_visibility.data());
+  if (has_irradiance) {
+    glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+    glPixelStorei(GL_UNPACK_ROW_LENGTH, 0);
+    glTextureSubImage2D(irradiance_.get(), 0, 0, 0, irradiance_width_, irradiance_height_, GL_RGB, GL_FLOAT,
+                        v.irradiance_atlas.data());
+  }
+  copy_.lights = v.lights;
+  check_gl_errors("IrradianceTextures::update_lighting");
+  return true;
 }
 
 void IrradianceTextures::bind(GLuint p) const {

@@ -18,6 +18,10 @@ class IrradianceTextures {
  public:
   // Throws InputError when the volume has more lights than the shader takes.
   explicit IrradianceTextures(const IrradianceVolume& volume);
+  // The same volume relit (IrradianceVolume::blend, relit_scene_lighting): uploads only
+  // what light changes (irradiance atlas, SH, light radiance and visibility) in place.
+  // False, changing nothing, when `volume`'s layout is not this one's.
+  bool update_lighting(const IrradianceVolume& volume);
   // Sets the uniforms of `program` and binds the textures to their units.
   void bind(GLuint program) const;
   std::size_t bytes() const { return bytes_; }
@@ -26,13 +30,14 @@ class IrradianceTextures {
   struct BufferTexture {
     GlName buffer, texture;
   };
-  static BufferTexture buffer_texture(GLenum format, const void* data, std::size_t bytes);
+  static BufferTexture buffer_texture(GLenum format, const void* data, std::size_t bytes, GLbitfield flags = 0);
   static GlName atlas(GLenum internal_format, GLenum format, int width, int height, const std::vector<float>& data);
 
   BufferTexture probes_, node_probe_, node_weight_, refined_, sh_, light_visibility_;
   GlName irradiance_, depth_;
   IrradianceVolume copy_;  // the uniforms' values (no arrays)
-  int storage_ = 0, shadow_offset_ = 0;
+  int storage_ = 0, shadow_offset_ = 0, irradiance_width_ = 0, irradiance_height_ = 0;
+  std::size_t probe_count_ = 0, sh_floats_ = 0;
   bool visibility_ = true, distant_ = false;
   std::size_t bytes_ = 0;
 };

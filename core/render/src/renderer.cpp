@@ -411,6 +411,11 @@ void Renderer::set_object_light_attenuation(int id, std::span<const glm::vec3> a
   check_gl_errors("Renderer::set_object_light_attenuation");
 }
 
+void Renderer::set_object_bounce_light(int id, std::span<const glm::vec3> irradiance) {
+  impl_->object(id, "set_object_bounce_light").mesh.set_bounce_light(irradiance);
+  check_gl_errors("Renderer::set_object_bounce_light");
+}
+
 void Renderer::set_object_self_occlusion(int id, std::span<const VertexOcclusion> occlusion) {
   std::vector<glm::vec4> packed(occlusion.size());
   for (std::size_t i = 0; i < occlusion.size(); ++i) packed[i] = glm::vec4(occlusion[i].bent_normal, occlusion[i].open);
@@ -429,6 +434,8 @@ void Renderer::set_object_material(int id, const glm::vec3& albedo, const SH9& i
 }
 
 void Renderer::set_irradiance_volume(const IrradianceVolume* volume) {
+  // The same volume relit (a fade of the room's light) updates its light in place.
+  if (volume && impl_->volume && impl_->volume->update_lighting(*volume)) return;
   impl_->volume = volume ? std::make_unique<IrradianceTextures>(*volume) : nullptr;
   check_gl_errors("Renderer::set_irradiance_volume");
 }

@@ -17,6 +17,7 @@ layout(location = 0) in vec3 position;
 layout(location = 1) in vec3 normal;
 layout(location = 2) in vec3 light_attenuation;  // objects: what other objects take of the light
 layout(location = 3) in vec4 occlusion;          // objects: bent normal (model space), open share
+layout(location = 4) in vec3 bounce_light;       // objects: irradiance the other objects reflect onto it
 uniform mat4 model;
 uniform mat3 normal_matrix;
 uniform mat4 view_projection;
@@ -24,6 +25,7 @@ out vec3 world_position;
 out vec3 world_normal;
 out vec3 attenuation;
 out vec4 self_occlusion;
+out vec3 bounce;
 // The objects' depth pre-pass and their shaded pass must agree to the bit (GL_LEQUAL).
 invariant gl_Position;
 void main() {
@@ -32,6 +34,7 @@ void main() {
   world_normal = normal_matrix * normal;
   attenuation = light_attenuation;
   self_occlusion = vec4(normal_matrix * occlusion.xyz, occlusion.w);
+  bounce = bounce_light;
   gl_Position = view_projection * w;
 }
 )glsl";
@@ -85,6 +88,7 @@ in vec3 world_position;
 in vec3 world_normal;
 in vec3 attenuation;
 in vec4 self_occlusion;  // bent normal (world; zero when not baked), open share
+in vec3 bounce;          // irradiance the other objects reflect onto this point
 uniform vec3 albedo;
 uniform float exposure;
 uniform vec3 sh[9];  // L00, L1-1, L10, L11, L2-2, L2-1, L20, L21, L22 (world frame)
@@ -108,6 +112,7 @@ void main() {
   // Nine coefficients can ring below zero opposite a bright source; light is never negative.
   vec3 irradiance = use_volume ? volume_irradiance(world_position, n) : max(sh_irradiance(n), vec3(0.0));
   irradiance *= clamp(attenuation, 0.0, 1.0) * open;
+  irradiance += max(bounce, vec3(0.0));
   color = vec4(albedo * irradiance * (exposure / 3.14159265358979), 1.0);
 }
 )glsl";

@@ -45,17 +45,32 @@ glm::vec3 EnvironmentMap::radiance(const glm::dvec3& world) const {
   return glm::vec3(top * (1.0 - fy) + bottom * fy);
 }
 
-EnvironmentMap scale_environment_map(const EnvironmentMap& map, const std::vector<glm::vec3>& ratios, int cols,
-                                     int rows) {
-  if (cols < 1 || rows < 1 || ratios.size() != std::size_t(cols) * std::size_t(rows))
-    throw InputError("environment map: " + std::to_string(ratios.size()) + " cell ratios for a " +
+glm::vec3 MapCellScale::at(const glm::dvec3& map_direction) const {
+  const glm::dvec2 uv = latlong_coordinates(glm::normalize(map_direction), cols, rows);
+  if (!std::isfinite(uv.x) || !std::isfinite(uv.y)) return glm::vec3(1.0f);
+  return rgb[std::size_t(std::clamp(int(uv.y), 0, rows - 1)) * std::size_t(cols) +
+             std::size_t(std::clamp(int(uv.x), 0, cols - 1))];
+}
+
+MapCellScale MapCellScale::blend(const MapCellScale& a, const MapCellScale& b, double w) {
+  if (a.cols != b.cols || a.rows != b.rows || a.rgb.size() != b.rgb.size())
+    throw RuntimeError("MapCellScale::blend: grids of different sizes");
+  MapCellScale out = b;
+  for (std::size_t k = 0; k < out.rgb.size(); ++k) out.rgb[k] = float(1.0 - w) * a.rgb[k] + float(w) * b.rgb[k];
+  return out;
+}
+
+EnvironmentMap scale_environment_map(const EnvironmentMap& map, const MapCellScale& scale) {
+  const int cols = scale.cols, rows = scale.rows;
+  if (cols < 1 || rows < 1 || scale.rgb.size() != std::size_t(cols) * std::size_t(rows))
+    throw InputError("environment map: " + std::to_string(scale.rgb.size()) + " cell factors for a " +
                      std::to_string(cols) + "x" + std::to_string(rows) + " grid");
   EnvironmentMap out = map;
   for (int r = 0; r < map.height; ++r) {
     const int cell_row = std::min(rows - 1, int((r + 0.5) * rows / map.height));
     for (int c = 0; c < map.width; ++c) {
-      const glm::vec3& k =
-          ratios[std::size_t(cell_row) * cols + std::size_t(std::min(cols - 1, int((c + 0.5) * cols / map.width)))];
+      const int cell_col = std::min(cols - 1, int((c + 0.5) * cols / map.width));
+      const glm::vec3& k = scale.rgb[std::size_t(cell_row) * cols + std::size_t(cell_col)];
       float* p = &out.rgb[(std::size_t(r) * map.width + c) * 3];
       p[0] *= k.r, p[1] *= k.g, p[2] *= k.b;
     }

@@ -198,6 +198,7 @@ int ObjectBounce::add_object(const Mesh& model, const glm::vec3& albedo, const g
     o.triangle_radius[t] = std::max({glm::length(a - centre), glm::length(b - centre), glm::length(c - centre)});
   }
   shade_clusters(o, {});
+  o.received.assign(model.positions.size(), glm::vec3(0.0f));
   objects_.push_back(std::move(o));
   dirty_ = true;
   return int(objects_.size()) - 1;
@@ -265,6 +266,14 @@ void ObjectBounce::set_object_albedo(int id, const glm::vec3& albedo) {
   dirty_ = true;
 }
 
+void ObjectBounce::relight(std::vector<glm::vec3> unshadowed) {
+  if (unshadowed.size() != positions_.size())
+    throw RuntimeError("ObjectBounce::relight: " + std::to_string(unshadowed.size()) + " values for " +
+                       std::to_string(positions_.size()) + " receivers");
+  unshadowed_ = std::move(unshadowed);
+  dirty_ = true;
+}
+
 bool ObjectBounce::update(const Irradiance& irradiance) {
   stats_.recomputed = false;
   if (!dirty_) return false;
@@ -273,7 +282,26 @@ bool ObjectBounce::update(const Irradiance& irradiance) {
   stats_.recomputed = true;
   std::fill(bounce_.begin(), bounce_.end(), glm::vec3(0.0f));
   for (const Object& o : objects_)
-    if (o.enabled && !o.surface.clusters.empty()) add_object_bounce(o, irradiance);
+    if (o.enabled && !o.surface.clusters.empty()) add_object_bounce(o, irradiance, positions_, normals_, bounce_);
+  // Onto each other: every object's vertices, posed, receive from the others.
+  const auto t1 = std::chrono::steady_clock::now();
+  for (std::size_t b = 0; b < objects_.size(); ++b) {
+    Object& to = objects_[b];
+    std::fill(to.received.begin(), to.received.end(), glm::vec3(0.0f));
+    if (objects_.size() < 2) continue;
+    const glm::mat4 T(to.T_world_model);
+    const glm::mat3 normal_matrix = glm::transpose(glm::inverse(glm::mat3(T)));
+    std::vector<glm::vec3> positions(to.model.positions.size()), normals(positions.size());
+    for (std::size_t v = 0; v < positions.size(); ++v) {
+      positions[v] = glm::vec3(T * glm::vec4(to.model.positions[v], 1.0f));
+      const glm::vec3 n = normal_matrix * to.model.normals[v];
+      normals[v] = glm::length(n) > 0 ? glm::normalize(n) : n;
+    }
+    for (std::size_t a = 0; a < objects_.size(); ++a)
+      if (a != b && objects_[a].enabled && !objects_[a].surface.clusters.empty())
+        add_object_bounce(objects_[a], irradiance, positions, normals, to.received);
+  }
+  stats_.onto_objects_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t1).count();
   for (std::size_t i = 0; i < positions_.size(); ++i) {
     for (int c = 0; c < 3; ++c) ratio_[i][c] = unshadowed_[i][c] > 0 ? bounce_[i][c] / unshadowed_[i][c] : 0.0f;
     stats_.receivers_reached += bounce_[i] != glm::vec3(0.0f);
@@ -283,7 +311,14 @@ bool ObjectBounce::update(const Irradiance& irradiance) {
   return true;
 }
 
-void ObjectBounce::add_object_bounce(const Object& o, const Irradiance& irradiance) {
+const std::vector<glm::vec3>& ObjectBounce::object_bounce(int id) const {
+  if (id < 0 || id >= int(objects_.size())) throw RuntimeError("bounce: no object " + std::to_string(id));
+  return objects_[std::size_t(id)].received;
+}
+
+void ObjectBounce::add_object_bounce(const Object& o, const Irradiance& irradiance,
+                                     std::span<const glm::vec3> positions, std::span<const glm::vec3> normals,
+                                     std::span<glm::vec3> out) {
   const glm::dmat4& T = o.T_world_model;
   const glm::dmat3 linear(T);
   const double scale = std::cbrt(std::abs(glm::determinant(linear)));
@@ -329,8 +364,8 @@ void ObjectBounce::add_object_bounce(const Object& o, const Irradiance& irradian
   }
 
   std::vector<std::uint32_t> near;
-  for (std::size_t i = 0; i < positions_.size(); ++i) {
-    const glm::vec3 x = positions_[i], nrm = normals_[i];
+  for (std::size_t i = 0; i < positions.size(); ++i) {
+    const glm::vec3 x = positions[i], nrm = normals[i];
     if (glm::length(x - middle) > reach) continue;
     near.clear();
     // Far clusters as points, four at a time: A cos θ_c cos θ_x / r², the cosines being
@@ -395,7 +430,7 @@ void ObjectBounce::add_object_bounce(const Object& o, const Irradiance& irradian
       }
       E += sum * radiance[k];
     }
-    bounce_[i] += E;
+    out[i] += E;
     stats_.pairs += n - near.size();
     stats_.near_pairs += near.size();
   }

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstring>
 #include <ctime>
+#include <limits>
 
 #include "cpu_clones.h"
 #include "lumar/base/error.h"
@@ -343,13 +344,52 @@ bool LineShadows::update() {
     blocked_lines_.erase(std::unique(blocked_lines_.begin(), blocked_lines_.end()), blocked_lines_.end());
   }
   stats_.cull_ms = cull_ms, stats_.trace_ms = trace_ms;
+  stats_.lines_blocked = blocked_lines_.size();
+  sum_attenuation();
+  return true;
+}
+
+void LineShadows::sum_attenuation() {
+  attenuation_.assign(lines_.receiver_count(), glm::vec3(1.0f));
+  const bool relit = !receiver_scale_.empty();
   for (const std::uint32_t li : blocked_lines_) {
     const ShadowLine& l = lines_.lines[li];
-    attenuation_[l.receiver] -= l.fraction;
+    attenuation_[l.receiver] -= relit ? l.fraction * sample_scale_[l.sample] / receiver_scale_[l.receiver] : l.fraction;
   }
-  stats_.lines_blocked = blocked_lines_.size();
   for (glm::vec3& a : attenuation_) a = glm::clamp(a, glm::vec3(0.0f), glm::vec3(1.0f));
-  return true;
+}
+
+void LineShadows::relight(const std::vector<glm::vec3>& sample_scale) {
+  if (sample_scale.size() != lines_.samples.size())
+    throw RuntimeError("LineShadows::relight: " + std::to_string(sample_scale.size()) + " factors for " +
+                       std::to_string(lines_.samples.size()) + " emitter samples");
+  const std::size_t R = lines_.receiver_count();
+  if (built_unshadowed_.empty()) {
+    built_unshadowed_ = lines_.unshadowed;
+    fraction_sum_.assign(R, glm::vec3(0.0f));
+    for (const ShadowLine& l : lines_.lines) fraction_sum_[l.receiver] += l.fraction;
+  }
+  // Per receiver, S = Σ f k / Σ f over its lines (by sample, so k is read once per run):
+  // its E_without scales by S, and a line's share becomes f k / S.
+  std::vector<glm::vec3> weighted(R, glm::vec3(0.0f));
+  for (std::uint32_t s = 0; s + 1 < lines_.sample_first.size(); ++s) {
+    const glm::vec3 k = sample_scale[s];
+    for (std::uint32_t i = lines_.sample_first[s]; i < lines_.sample_first[s + 1]; ++i)
+      weighted[lines_.lines[i].receiver] += lines_.lines[i].fraction * k;
+  }
+  sample_scale_ = sample_scale;
+  receiver_scale_.assign(R, glm::vec3(1.0f));
+  for (std::size_t r = 0; r < R; ++r)
+    for (int c = 0; c < 3; ++c) {
+      if (fraction_sum_[r][c] > 0) receiver_scale_[r][c] = weighted[r][c] / fraction_sum_[r][c];
+      // All its light out: no share left to block (and no division by zero).
+      if (!(receiver_scale_[r][c] > 0)) receiver_scale_[r][c] = std::numeric_limits<float>::infinity();
+    }
+  for (std::size_t r = 0; r < R; ++r)
+    for (int c = 0; c < 3; ++c)
+      lines_.unshadowed[r][c] =
+          std::isinf(receiver_scale_[r][c]) ? 0.0f : built_unshadowed_[r][c] * receiver_scale_[r][c];
+  sum_attenuation();
 }
 
 }  // namespace lumar

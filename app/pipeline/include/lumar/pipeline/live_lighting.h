@@ -25,6 +25,7 @@ namespace lumar::pipeline {
 
 struct LiveLightingSettings {
   int every_n_frames = 1;  // compare on every n-th frame with a pose
+  int cell_cols = 32;      // cells over the map's directions (the knob), cell_cols / 2 rows
   double fade_s = 0.5;     // from the old lighting to the re-baked one, frame time
   bool background = true;  // bake on a thread (live); false: at once (replay)
 };
@@ -52,6 +53,9 @@ class LiveLighting {
   int measurements() const { return measurements_; }
   int bakes() const { return bakes_; }  // re-baked lightings swapped in
   double last_bake_ms() const { return bake_ms_; }
+  // The longest a frame spent handing the compositor a faded lighting (blend, upload,
+  // shadow lines relit): what a change costs the frames that show it.
+  double worst_fade_step_ms() const { return worst_fade_step_ms_; }
   bool transition() const { return fading_ || pending_.valid(); }  // a bake or a fade under way
 
  private:
@@ -69,7 +73,7 @@ class LiveLighting {
   calib::CameraResponse response_;
   double exposure_;
   int calls_ = 0, measurements_ = 0, bakes_ = 0;
-  double bake_ms_ = 0;
+  double bake_ms_ = 0, worst_fade_step_ms_ = 0;
   calib::LightingAdapter adapter_;
 
   std::shared_ptr<const LoadedScene> scene_;  // the compositor's, while this lighting is its

@@ -26,7 +26,8 @@ struct OverlaySettings {
   // > 0: every that many frames, compare the video with the map and follow the room's
   // light per direction and colour: re-baked, faded in (live_lighting.h).
   int adapt_lighting_every = 0;
-  bool window = false;  // a GLFW window to draw into; else a headless EGL context
+  int adapt_lighting_cells = 32;  // the map's directions in that many columns (half as many rows)
+  bool window = false;            // a GLFW window to draw into; else a headless EGL context
   std::string window_title = "lumar overlay";
   // > 0: room for panels right of the video (the interactive window), which is then at
   // least 720 pixels tall; else the window is the camera's size.
@@ -110,7 +111,7 @@ class Overlay {
   CameraIntrinsics camera_;  // the video's, distorted
   capture::Radiometry session_radiometry_;
   std::optional<LiveLighting> live_lighting_;
-  int lighting_every_ = 0;
+  int lighting_every_ = 0, lighting_cells_ = 32;
   // The camera's noise and blur, measured from the video until they are known.
   void measure_camera(const cv::Mat& video);
   calib::UndistortionMaps maps_;

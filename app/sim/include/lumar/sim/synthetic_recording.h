@@ -6,9 +6,10 @@
 #include <cstdint>
 #include <filesystem>
 #include <functional>
-#include <optional>
 #include <opencv2/core.hpp>
+#include <optional>
 #include <string>
+#include <vector>
 
 #include "lumar/base/camera.h"
 #include "lumar/base/pose.h"
@@ -84,6 +85,15 @@ Pose orbit_camera_pose(const glm::dvec3& target, double s, double arc_deg);
 // The camera's true pose at s in [0, 1] along the named path ("orbit", "still");
 // InputError for another name.
 Pose synth_camera_pose(const std::string& path, const glm::dvec3& target, double s, double arc_deg);
+
+// The sample room's two light changes (data/scenes/room; the tests and
+// bench_lighting_change): "lamp-off", the ceiling lamp at (-1.2, 3, 0.3) going out at
+// 2.5 s (13 % of the map's power), 120 frames; "warmer-window", the window's light
+// ×(1.5, 1, 0.5) over 0.5 s from 1.5 s (16 % of the power), 96 frames at a third of the
+// automatic exposure so that the window does not clip. Both on the "room" path at 24
+// frames/s, one sample per pixel. `camera`: the calibrated camera.
+std::vector<SynthSettings> sample_room_light_changes(const std::filesystem::path& scene, const CameraIntrinsics& camera,
+                                                     const std::filesystem::path& out_dir);
 
 // Writes the recording into settings.out (which must not exist yet). Throws
 // InputError / RuntimeError; on failure the partial recording directory is removed.

@@ -22,16 +22,20 @@ std::unique_ptr<RoomRadiance> scene_radiance(const LoadedScene& scene, const Rad
 IrradianceVolume scene_irradiance_volume(const LoadedScene& scene, const std::string& method, bool use_cache = true,
                                          const std::filesystem::path& cache_dir = {}, bool* loaded = nullptr);
 
-// The scene's lighting after the room changed (pipeline/live_lighting.h): its map relit
-// (scale_environment_map), the irradiance volume over the movement box rebuilt from
-// `base` relit to that map, so that it has the layout of the scene's own volume and the
-// two can be blended (IrradianceVolume::blend), and the map's SH9. `base`: the scene's
-// radiance, scene_radiance(scene, scene_volume_settings(...).radiance). No volume when
-// the manifest's lighting.method is "sh9".
+// The scene's lighting after the room changed (pipeline/live_lighting.h): the change
+// per map cell; the irradiance volume over the movement box rebuilt from `base` relit to
+// the scaled map, so that it has the layout of the scene's own volume and the two can be
+// blended (IrradianceVolume::blend); the scaled map's SH9. `base`: the scene's radiance,
+// scene_radiance(scene, scene_volume_settings(...).radiance). No volume when the
+// manifest's lighting.method is "sh9".
 struct SceneLighting {
+  MapCellScale scale;
   std::shared_ptr<const IrradianceVolume> volume;
   SH9 sh{};
+
+  // (1 - w) a + w b: the lighting of the blended light.
+  static SceneLighting blend(const SceneLighting& a, const SceneLighting& b, double w);
 };
-SceneLighting relit_scene_lighting(const LoadedScene& scene, const RoomRadiance& base, const EnvironmentMap& map);
+SceneLighting relit_scene_lighting(const LoadedScene& scene, const RoomRadiance& base, const MapCellScale& scale);
 
 }  // namespace lumar

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "lumar/base/camera.h"
+#include "lumar/lighting/irradiance_scene.h"
 #include "lumar/lighting/sh.h"
 #include "lumar/render/renderer.h"
 #include "lumar/scene/loaded_scene.h"
@@ -65,8 +66,9 @@ class Compositor {
   const ShadowQuality& shadow_quality() const { return shadow_quality_; }
   // Antialiasing, self-occlusion, noise, blur and bounce (gl::CompositeFeatures); all on
   // by default. The objects' self-occlusion is baked the first time it is on. Bounce is
-  // the light the objects reflect onto the receivers, added to their shadows
-  // (lighting/shadows/object_bounce.h), for objects whose manifest entry allows it.
+  // the light the objects reflect onto the receivers, added to their shadows, and onto
+  // each other, added to their shading (lighting/shadows/object_bounce.h), from objects
+  // whose manifest entry allows it.
   void set_features(const gl::CompositeFeatures& features);
   // The shadow lines, or nullptr when the scene has no receivers.
   const LineShadows* shadows() const { return shadows_.get(); }
@@ -75,12 +77,13 @@ class Compositor {
   // The objects' light on the receivers, or nullptr when the scene has no receivers.
   const ObjectBounce* bounce() const { return bounce_.get(); }
 
-  // The room's light changed (pipeline/live_lighting.h): shade the objects, and the light
-  // they reflect, from this volume (nullptr with lighting.method "sh9") and SH9, made by
-  // relit_scene_lighting or blended from two such. The renderer's environment map stays
-  // the captured one, the reference the changes are measured against. The shadow lines
-  // keep the captured map's emitter powers.
-  void set_lighting(std::shared_ptr<const IrradianceVolume> volume, const SH9& sh);
+  // The room's light changed (pipeline/live_lighting.h): shade the objects from this
+  // lighting (relit_scene_lighting, or a blend of two), and scale the shadow lines'
+  // emitters by its change per map cell, so a lamp that went out takes its shadows with
+  // it; the light the objects reflect follows. The renderer's environment map stays the
+  // captured one, the reference the changes are measured against. The objects' shadows
+  // on each other keep the captured map's emitters.
+  void set_lighting(const SceneLighting& lighting);
 
   gl::Renderer& renderer() { return *renderer_; }
   const LoadedScene& scene() const { return *scene_; }
@@ -115,6 +118,9 @@ class Compositor {
   std::shared_ptr<ObjectShadows> object_shadows_;
   std::shared_ptr<ObjectBounce> bounce_;
   ShadowQuality shadow_quality_;
+  MapCellScale light_scale_;  // the room's change since the map was captured (set_lighting)
+  void relight_shadows();
+  void upload_object_bounce(bool on);
   bool shadows_enabled_ = true, object_shadows_enabled_ = true, shadows_uploaded_ = false,
        object_shadows_uploaded_ = false;
 };

@@ -85,11 +85,15 @@ class Renderer {
   // other objects block some of it (object_shadows.h): multiplies its irradiance.
   // 1 until set; throws InputError unless there is one value per vertex.
   void set_object_light_attenuation(int id, std::span<const glm::vec3> attenuation);
+  // Per vertex (mesh order): the irradiance the other objects reflect onto it, added to
+  // its shading (lighting/shadows/object_bounce.h). Unset: none.
+  void set_object_bounce_light(int id, std::span<const glm::vec3> irradiance);
   // Per vertex (mesh order), the object's occlusion of itself (bake_self_occlusion);
   // unset, the object is open everywhere. Throws InputError unless one value per vertex.
   void set_object_self_occlusion(int id, std::span<const VertexOcclusion> occlusion);
   // Shade every object per pixel from this irradiance volume (uploaded as textures;
-  // core/irradiance_volume.h) instead of its SH9; nullptr goes back to SH9.
+  // core/irradiance_volume.h) instead of its SH9; nullptr goes back to SH9. A volume of
+  // the current one's layout (the same room relit) only updates its light.
   void set_irradiance_volume(const IrradianceVolume* volume);
 
   // Shadow receivers (world mesh of real surfaces): in render_overlay the video under

@@ -27,11 +27,21 @@ struct EnvironmentMap {
 // Mean luminance over the sphere, each texel weighted by its solid angle.
 double mean_luminance(const EnvironmentMap& map);
 
-// The map relit by a coarse grid of cells over its own lat-long coordinates: each texel
-// times the RGB ratio of the cell its centre falls in (`ratios`: rows x cols, row-major,
-// row 0 at the top). InputError when the grid and the ratios disagree.
-EnvironmentMap scale_environment_map(const EnvironmentMap& map, const std::vector<glm::vec3>& ratios, int cols,
-                                     int rows);
+// A coarse grid of RGB factors over a map's own lat-long directions (row 0 at the top):
+// how each part of the room's light changed (pipeline/live_lighting.h). One cell of 1: none.
+struct MapCellScale {
+  int cols = 1, rows = 1;
+  std::vector<glm::vec3> rgb{glm::vec3(1.0f)};  // rows x cols, row-major
+
+  // The factor of the cell a map direction (need not be unit) falls in.
+  glm::vec3 at(const glm::dvec3& map_direction) const;
+  // (1 - w) a + w b, cell by cell; the grids must match.
+  static MapCellScale blend(const MapCellScale& a, const MapCellScale& b, double w);
+};
+
+// The map relit: each texel times the factor of the cell its centre falls in.
+// InputError when the grid and its factors disagree.
+EnvironmentMap scale_environment_map(const EnvironmentMap& map, const MapCellScale& scale);
 
 // Reads an OpenEXR or Radiance HDR file through OpenImageIO (first three channels).
 // Throws InputError naming the file when it is missing, unreadable or not 2:1.

@@ -70,9 +70,10 @@ SurfaceClusters surface_clusters(const Mesh& mesh, int count, int children = 8);
 struct BounceStats {
   bool recomputed = false;
   std::size_t receivers_reached = 0;  // receivers within reach of at least one object
-  std::size_t pairs = 0;              // (receiver, cluster) pairs summed as points
-  std::size_t near_pairs = 0;         // (receiver, cluster) pairs summed triangle by triangle
+  std::size_t pairs = 0;              // (receiver or vertex, cluster) pairs summed as points
+  std::size_t near_pairs = 0;         // (receiver or vertex, cluster) pairs summed triangle by triangle
   double ms = 0;                      // wall time of the update (one thread)
+  double onto_objects_ms = 0;         // of which onto each other's vertices
 };
 
 class ObjectBounce {
@@ -99,11 +100,17 @@ class ObjectBounce {
   // Recomputes if an object moved, was added or changed since the last call; returns
   // whether it did.
   bool update(const Irradiance& irradiance);
-  // The light on the objects changed (the room was relit): the next update recomputes.
-  void relight() { dirty_ = true; }
+  // The light on the objects changed (the room was relit), and with it the receivers'
+  // unshadowed irradiance (one per receiver): the next update recomputes.
+  void relight(std::vector<glm::vec3> unshadowed);
 
   // Per receiver, E_bounce / E_without per channel (0 where nothing reaches it).
   const std::vector<glm::vec3>& ratio() const { return ratio_; }
+  // Per vertex of object id's mesh (model order): the irradiance the OTHER objects
+  // reflect onto it (virtual onto virtual: a red box tints the figurine beside it), by
+  // the same transfer as onto the receivers; all 0 with one object. RuntimeError for a
+  // bad id.
+  const std::vector<glm::vec3>& object_bounce(int id) const;
   const BounceStats& stats() const { return stats_; }
   std::size_t receiver_count() const { return positions_.size(); }
   const BounceSettings& settings() const { return settings_; }
@@ -124,9 +131,12 @@ class ObjectBounce {
     std::vector<float> cluster_open;
     std::vector<glm::vec3> triangle_centre, triangle_facing;
     std::vector<float> triangle_area, triangle_radius;
+    std::vector<glm::vec3> received;  // per vertex: what the other objects reflect onto it
   };
   static void shade_clusters(Object& o, std::span<const VertexOcclusion> occlusion);
-  void add_object_bounce(const Object& o, const Irradiance& irradiance);
+  // Adds what `o` reflects onto the points (world, unit normals) into `out`.
+  void add_object_bounce(const Object& o, const Irradiance& irradiance, std::span<const glm::vec3> positions,
+                         std::span<const glm::vec3> normals, std::span<glm::vec3> out);
 
   std::vector<glm::vec3> positions_, normals_, unshadowed_;
   BounceSettings settings_;

@@ -53,7 +53,14 @@ class LineShadows {
   // Recomputes the attenuation if an object moved (or was added) since the last call;
   // returns whether it did.
   bool update();
-  // Per receiver, E_with / E_without per channel, in [0, 1].
+  // The room's light changed: each emitter sample's light is `sample_scale` (RGB, one per
+  // lines().samples) times what it was when the lines were built. Each receiver's
+  // E_without and its lines' shares follow (the dropped share scaling as the rest), and
+  // the attenuation is recomputed at once for the lines blocked now. No tracing.
+  void relight(const std::vector<glm::vec3>& sample_scale);
+
+  // Per receiver, E_with / E_without per channel, in [0, 1]. (lines() keeps the shares
+  // as built; after relight, lines().unshadowed is the relit E_without.)
   const std::vector<glm::vec3>& attenuation() const { return attenuation_; }
   const ShadowFrameStats& stats() const { return stats_; }
   const ShadowLines& lines() const { return lines_; }
@@ -85,7 +92,12 @@ class LineShadows {
   void trace(Object& o);
   void trace_all(const Object& o);
 
+  void sum_attenuation();
+
   ShadowLines lines_;
+  // Relit (relight): each sample's factor k, each receiver's S; a line's share is then
+  // fraction × k / S. Empty: as built. The lines themselves keep their built shares.
+  std::vector<glm::vec3> sample_scale_, receiver_scale_, fraction_sum_, built_unshadowed_;
   std::vector<Object> objects_;
   bool culling_ = true, dirty_ = true;
   std::vector<glm::vec3> attenuation_;
