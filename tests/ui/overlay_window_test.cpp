@@ -234,13 +234,18 @@ TEST_F(OverlayWindow, PlaceSlideTurnShadowsSaveAndBadMeshes) {
   const glm::dvec3 hit = floor_hit(camera, pose, click.x, click.y);
   EXPECT_LT(glm::distance(foot, hit), 0.002) << "floor hit " << hit.x << ", " << hit.z;
 
-  // A 100 px drag slides it along the floor by what the rays' floor hits say.
-  xdotool("mousedown 1");
-  for (int x = 240; x <= 320; x += 20) {
-    xdotool("mousemove --window " + window_ + " " + std::to_string(x) + " 400");
+  // A 100 px drag slides it along the floor by what the rays' floor hits say. The press
+  // and the first move, and the last move and the release, come in one xdotool call each:
+  // faster than a frame, as a quick hand on a slow machine (the window reads the pointer
+  // once a frame, so it must take the press's and release's own positions).
+  const auto move_to = [&](int x) { return "mousemove --window " + window_ + " " + std::to_string(x) + " 400"; };
+  xdotool("mousedown 1 " + move_to(240));
+  for (int x = 260; x <= 300; x += 20) {
     std::this_thread::sleep_for(std::chrono::milliseconds(150 * test::time_scale()));
+    xdotool(move_to(x));
   }
-  xdotool("mouseup 1");
+  std::this_thread::sleep_for(std::chrono::milliseconds(150 * test::time_scale()));
+  xdotool(move_to(320) + " mouseup 1");
   pause_for_frames();
   const LoadedScene dragged = load_scene_files(save_as("dragged.json"));
   const glm::dvec3 moved = glm::dvec3(dragged.objects[0].T_world_model[3] - placed.objects[0].T_world_model[3]);

@@ -31,11 +31,14 @@
 namespace lumar::ui {
 
 // Dear ImGui's context and its GLFW and OpenGL 3 backends, for one window's life.
-// `on_key` is installed first, so that ImGui's backend passes every key on to it.
+// `on_key` and `on_button` are installed first, so that ImGui's backend passes every key
+// and button on to them; `on_cursor` is ours alone (ImGui 1.86 polls the pointer).
 class ImGuiSession {
  public:
-  ImGuiSession(GLFWwindow* window, GLFWkeyfun on_key) {
+  ImGuiSession(GLFWwindow* window, GLFWkeyfun on_key, GLFWmousebuttonfun on_button, GLFWcursorposfun on_cursor) {
     glfwSetKeyCallback(window, on_key);
+    glfwSetMouseButtonCallback(window, on_button);
+    glfwSetCursorPosCallback(window, on_cursor);
     IMGUI_CHECKVERSION();
     ImGui::CreateContext();
     ImGui::GetIO().IniFilename = nullptr;  // no imgui.ini beside the user's files
@@ -71,11 +74,14 @@ class OverlayUi {
       : overlay_(overlay),
         window_(window),
         editor_(overlay),
-        imgui_(window.glfw_window(), &OverlayUi::on_key),
+        imgui_(window.glfw_window(), &OverlayUi::on_key, &OverlayUi::on_button, &OverlayUi::on_cursor),
         save_path_(settings.save_scene.string()),
         screenshot_path_(settings.screenshot.string()) {
     features_ = overlay_.compositor().renderer().features();
     glfwSetWindowUserPointer(window_.glfw_window(), this);
+    double x = 0, y = 0;
+    glfwGetCursorPos(window_.glfw_window(), &x, &y);
+    pointer_ = press_at_ = release_at_ = ImVec2(float(x), float(y));
   }
   ~OverlayUi() { glfwSetWindowUserPointer(window_.glfw_window(), nullptr); }
   OverlayUi(const OverlayUi&) = delete;
@@ -174,21 +180,22 @@ class OverlayUi {
       return;
     }
     const std::size_t i = selected();
-    if (ImGui::IsMouseClicked(ImGuiMouseButton_Left) && over_video(io.MousePos)) {
+    if (ImGui::IsMouseClicked(ImGuiMouseButton_Left) && over_video(press_at_)) {
       pressed_ = true;
       dragging_ = false;
-      press_pos_ = io.MousePos;
+      press_pos_ = press_at_;
       press_pose_ = editor_.scene().objects[i].T_world_model;
       press_rest_ = editor_.rest(i);
-      press_surface_ = surface_under(io.MousePos);
+      press_surface_ = surface_under(press_at_);
     }
     const bool released = pressed_ && ImGui::IsMouseReleased(ImGuiMouseButton_Left);
     if (pressed_ && (ImGui::IsMouseDown(ImGuiMouseButton_Left) || released)) {
-      const float dx = io.MousePos.x - press_pos_.x, dy = io.MousePos.y - press_pos_.y;
+      const ImVec2 mouse = released ? release_at_ : io.MousePos;
+      const float dx = mouse.x - press_pos_.x, dy = mouse.y - press_pos_.y;
       if (!dragging_ && dx * dx + dy * dy > kDragPx * kDragPx) dragging_ = true;
-      // To where the mouse is, also on the frame it is let go.
+      // To where the mouse is, and on the frame it is let go to where it was let go.
       if (dragging_ && press_surface_)
-        if (const auto here = surface_under(io.MousePos)) {
+        if (const auto here = surface_under(mouse)) {
           // Along the surface it was grabbed on: the offset between the rays' two hits.
           glm::dvec3 offset = here->point - press_surface_->point;
           offset -= glm::dot(offset, press_rest_.normal) * press_rest_.normal;
@@ -231,6 +238,19 @@ class OverlayUi {
   static void on_key(GLFWwindow* window, int key, int /*scancode*/, int action, int mods) {
     if (auto* self = static_cast<OverlayUi*>(glfwGetWindowUserPointer(window)); self && action != GLFW_RELEASE)
       self->keys_.push_back({key, mods, action == GLFW_REPEAT});
+  }
+
+  // Where the pointer was when the left button went down and up, in the order the events
+  // came. ImGui 1.86 reads the pointer once a frame, live: after a slow frame it is
+  // already further along a drag than where the press was, and the object would jump.
+  static void on_cursor(GLFWwindow* window, double x, double y) {
+    if (auto* self = static_cast<OverlayUi*>(glfwGetWindowUserPointer(window)))
+      self->pointer_ = ImVec2(float(x), float(y));
+  }
+  static void on_button(GLFWwindow* window, int button, int action, int /*mods*/) {
+    auto* self = static_cast<OverlayUi*>(glfwGetWindowUserPointer(window));
+    if (!self || button != GLFW_MOUSE_BUTTON_LEFT) return;
+    (action == GLFW_PRESS ? self->press_at_ : self->release_at_) = self->pointer_;
   }
 
   void handle_keys(const std::function<bool(const KeyPress&)>& source_keys) {
@@ -507,7 +527,7 @@ class OverlayUi {
   // editing
   std::size_t selected_ = 0;
   bool pressed_ = false, dragging_ = false, focus_mesh_field_ = false;
-  ImVec2 press_pos_;
+  ImVec2 press_pos_, pointer_, press_at_, release_at_;
   glm::dmat4 press_pose_{1.0};
   SurfacePoint press_rest_;
   std::optional<SurfacePoint> press_surface_;
