@@ -94,7 +94,9 @@ void run_live(OverlayOptions& o) {
   const auto started = std::chrono::steady_clock::now();
   if (!o.recording.empty()) throw InputError("overlay: give --recording or --source, not both");
   if (!o.contact_sheet.empty()) throw InputError("--contact-sheet: a live run has no known length; use --frames-dir");
-  if (o.poses != "tracker") throw InputError("--poses truth: a live source has no ground truth");
+  if (o.poses == "truth") throw InputError("--poses truth: a live source has no ground truth");
+  if (o.poses == "fused")
+    throw InputError("--poses fused: steadying by the video is for recordings so far; use tracker");
   pipeline::LiveOverlayOptions& live = o.live;
   live.scene = o.scene;
   live.max_frames = o.max_frames;
@@ -130,7 +132,9 @@ void run_replay(const OverlayOptions& o) {
         "recording's session.json already says them");
   pipeline::ReplayOverlaySettings settings;
   settings.scene = o.scene;
-  settings.poses = o.poses == "truth" ? pipeline::PoseSource::Truth : pipeline::PoseSource::Tracker;
+  settings.poses = o.poses == "truth"   ? pipeline::PoseSource::Truth
+                   : o.poses == "fused" ? pipeline::PoseSource::Fused
+                                        : pipeline::PoseSource::Tracker;
   settings.filter = tracking::parse_pose_filter(o.filter);
   settings.allow_incomplete = o.allow_incomplete;
   settings.overlay = overlay_settings(o, o.window);
@@ -189,8 +193,10 @@ void register_overlay(CLI::App& app) {
   cmd->add_option("--out", o->out, "Output video (.mp4, .mkv or .avi)");
   cmd->add_option("--frames-dir", o->frames_dir, "Also write every output frame as PNG into this new folder");
   cmd->add_option("--contact-sheet", o->contact_sheet, "Also write 8 frames spread over the run, tiled, as one PNG");
-  cmd->add_option("--poses", o->poses, "Camera poses from the tracker stream or from the recording's ground truth")
-      ->check(CLI::IsMember({"tracker", "truth"}))
+  cmd->add_option("--poses", o->poses,
+                  "Camera poses: the tracker stream, the tracker steadied by the video (fused), or the recording's "
+                  "ground truth")
+      ->check(CLI::IsMember({"tracker", "fused", "truth"}))
       ->capture_default_str();
   cmd->add_option("--filter", o->filter,
                   "Pose filter on the tracker's samples: none, one-euro (the setting the filter benchmark chose: "

@@ -122,6 +122,27 @@ case_window_without_display_fails_cleanly() {
 case_regress_sample() {
   "$LUMAR" regress "$REC" "$SRC/recordings/walk" | tee "$TMP/log" || fail "regression failed"
   [ "$(grep -c "^PASS" "$TMP/log")" -eq 2 ] || fail "expected two PASS lines (orbit, walk)"
+  # Registration with the tracker's poses and with the video's help, by name for other tools.
+  "$LUMAR" regress --json "$REC" >"$TMP/json" 2>"$TMP/log" || { cat "$TMP/log"; fail "regress --json failed"; }
+  python3 - "$TMP/json" <<'PY' || fail "registration keys"
+import json, sys
+r = json.loads(open(sys.argv[1]).read().splitlines()[0])
+for k in ("fused_mean_px", "fused_p95_px", "tracker_mean_px", "tracker_p95_px"):
+    assert isinstance(r[k], float), k
+print("tracker %.2f px, fused %.2f px (p95 %.2f, %.2f)" % (r["tracker_mean_px"], r["fused_mean_px"],
+                                                           r["tracker_p95_px"], r["fused_p95_px"]))
+assert r["fused_mean_px"] < 0.3 * r["tracker_mean_px"], "the video's help shows"
+assert r["fused_p95_px"] < r["tracker_p95_px"]
+PY
+}
+
+case_overlay_fused_poses() {
+  # The same frames with the tracker's poses steadied by the video; a live source refuses it.
+  "$LUMAR" overlay --recording "$REC" --poses fused --max-frames 4 --frames-dir "$TMP/fused" >"$TMP/log" 2>&1 ||
+    { cat "$TMP/log"; fail "overlay --poses fused failed"; }
+  [ "$(ls "$TMP/fused" | grep -c png)" -eq 4 ] || fail "expected 4 frames"
+  expect_bad_input "--poses fused" "" -- "$LUMAR" overlay --source "recording:$REC" --poses fused --scene \
+    "$SRC/data/scenes/room/scene.json"
 }
 
 # A copy of the sample recording at the same depth, so its relative scene path still resolves.

@@ -26,21 +26,26 @@ ReplayOverlay::ReplayOverlay(const std::filesystem::path& recording, const Repla
   const capture::Session& session = replay_.session();
   overlay_ = std::make_unique<Overlay>(std::move(scene), session.camera, session.radiometry,
                                        calib::calibrated_response(session.radiometry, recording), settings.overlay);
+  set_pose_source(pose_source_);
 }
 
 void ReplayOverlay::set_pose_filter(const std::optional<tracking::PoseFilterSettings>& filter) {
   replay_ = capture::RecordingReplay(recording_, filter);
+  set_pose_source(pose_source_);
 }
 
 void ReplayOverlay::set_pose_source(PoseSource source) {
   if (source == PoseSource::Truth && replay_.reader().truth().empty())
     throw InputError("this recording has no ground truth (truth.csv); use the tracker's poses");
   pose_source_ = source;
+  fused_.reset();
+  if (source == PoseSource::Fused) fused_ = std::make_unique<ImageAidedPose>(replay_.session().camera, scene().room);
 }
 
-std::optional<Pose> ReplayOverlay::camera_pose(const capture::Frame& frame) const {
-  return pose_source_ == PoseSource::Truth ? replay_.true_camera_pose(frame.index)
-                                           : replay_.tracked_camera_pose(frame.time);
+std::optional<Pose> ReplayOverlay::camera_pose(const capture::Frame& frame) {
+  if (pose_source_ == PoseSource::Truth) return replay_.true_camera_pose(frame.index);
+  const std::optional<Pose> tracked = replay_.tracked_camera_pose(frame.time);
+  return fused_ ? fused_->update(frame, tracked) : tracked;
 }
 
 void ReplayOverlay::run(int max_frames, const std::function<bool(const OverlayFrame&)>& sink) {

@@ -127,10 +127,11 @@ class ReplayWindow {
     ImGui::Text("%.2f s of %.2f s, %s", nanos_to_seconds(frame_.time),
                 nanos_to_seconds(replay_.replay().reader().frames().back().time),
                 ui_.pose() ? "pose known" : "no pose: video only");
-    bool truth = replay_.pose_source() == pipeline::PoseSource::Truth;
-    if (ImGui::Checkbox("true poses (not the tracker's)", &truth))
+    // The order of pipeline::PoseSource.
+    int source = int(replay_.pose_source());
+    if (ImGui::Combo("poses", &source, "tracker\0tracker steadied by the video\0truth\0"))
       ui_.attempt("poses", [&] {
-        replay_.set_pose_source(truth ? pipeline::PoseSource::Truth : pipeline::PoseSource::Tracker);
+        replay_.set_pose_source(pipeline::PoseSource(source));
         ui_.set_dirty(true);
       });
     if (ImGui::Checkbox("One Euro filter on the tracker's poses", &filtered_))

@@ -79,6 +79,8 @@ class Overlay {
   // Moves the animated objects to where their paths are at the frame's time, adapts the
   // lighting (with a pose, on every n-th call) and composites the frame.
   OverlayFrame composite(const capture::Frame& frame, const std::optional<Pose>& T_world_camera);
+  // Only the first step of composite(): the animated objects where their paths are then.
+  void play_paths(Nanos frame_time);
 
   // Swaps in another scene (objects added or removed, another lighting method): a new
   // compositor with this one's features, shadow switch and measured camera; the
@@ -121,7 +123,6 @@ class Overlay {
   std::int64_t frames_seen_ = 0;
   bool live_ = false, volume_cache_ = true;
   std::optional<Nanos> first_frame_time_;
-  void play_paths(Nanos frame_time);
   StageTimes times_;
   std::optional<std::chrono::steady_clock::time_point> first_composite_;
   int frames_without_pose_ = 0;

@@ -1,20 +1,24 @@
 #pragma once
 // The overlay over a recording, shared by `lumar overlay`, `lumar regress` and the
 // benchmarks: recording -> frames and camera poses (the tracker stream through the real
-// parser and the pose filter, or the recording's truth) -> Overlay -> output frames.
+// parser and the pose filter, that stream steadied by the video, or the recording's
+// truth) -> Overlay -> output frames.
 #include <filesystem>
 #include <functional>
 #include <memory>
 #include <optional>
 
 #include "lumar/capture/recording_replay.h"
+#include "lumar/pipeline/image_aided_pose.h"
 #include "lumar/pipeline/overlay.h"
 #include "lumar/scene/loaded_scene.h"
 #include "lumar/tracking/one_euro_filter.h"
 
 namespace lumar::pipeline {
 
-enum class PoseSource { Tracker, Truth };
+// Tracker: the tracker stream alone. Fused: the tracker's poses steadied by the video
+// (image_aided_pose.h). Truth: the recording's ground truth.
+enum class PoseSource { Tracker, Fused, Truth };
 
 struct ReplayOverlaySettings {
   std::filesystem::path scene;  // empty: the one the recording's session names
@@ -36,8 +40,9 @@ class ReplayOverlay {
   void run(int max_frames, const std::function<bool(const OverlayFrame&)>& sink);
 
   // The camera's pose for a frame of this recording, from the settings' source (nullopt:
-  // the tracker has nothing for it).
-  std::optional<Pose> camera_pose(const capture::Frame& frame) const;
+  // the tracker has nothing for it). Fused poses want the frames in order; any other
+  // frame starts the fusion again from the tracker.
+  std::optional<Pose> camera_pose(const capture::Frame& frame);
   PoseSource pose_source() const { return pose_source_; }
   // Truth: InputError when the recording has none.
   void set_pose_source(PoseSource source);
@@ -60,6 +65,7 @@ class ReplayOverlay {
   capture::RecordingReplay replay_;
   PoseSource pose_source_;
   std::unique_ptr<Overlay> overlay_;
+  std::unique_ptr<ImageAidedPose> fused_;  // while the source is Fused
 };
 
 }  // namespace lumar::pipeline

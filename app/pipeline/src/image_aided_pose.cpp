@@ -1,0 +1,158 @@
+#include "lumar/pipeline/image_aided_pose.h"
+
+#include <cmath>
+#include <opencv2/calib3d.hpp>
+#include <opencv2/imgproc.hpp>
+#include <opencv2/video/tracking.hpp>
+
+#include "lumar/base/error.h"
+
+namespace lumar::pipeline {
+
+namespace {
+
+constexpr std::int64_t kMaxDroppedFrames = 30;
+
+// Corners in pixels to points on the normalised image plane (distortion removed).
+std::vector<cv::Point2f> normalised(const CameraIntrinsics& camera, const std::vector<cv::Point2f>& pixels) {
+  std::vector<cv::Point2f> out;
+  if (!pixels.empty())
+    cv::undistortPoints(pixels, out, cv::Mat(camera.camera_matrix()), camera.distortion_coefficients());
+  return out;
+}
+
+Pose pose_from_opencv(const cv::Vec3d& rvec, const cv::Vec3d& tvec) {
+  cv::Matx33d R;
+  cv::Rodrigues(rvec, R);
+  glm::dmat4 m(1.0);
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) m[c][r] = R(r, c);
+    m[3][r] = tvec[r];
+  }
+  return Pose::from_matrix(m).inverse();  // OpenCV's is T_camera_world
+}
+
+void pose_to_opencv(const Pose& T_world_camera, cv::Vec3d& rvec, cv::Vec3d& tvec) {
+  const Pose T = T_world_camera.inverse();
+  const glm::dmat3 M = T.rotation_matrix();
+  cv::Matx33d R;
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) R(r, c) = M[c][r];
+  cv::Rodrigues(R, rvec);
+  tvec = cv::Vec3d(T.translation.x, T.translation.y, T.translation.z);
+}
+
+}  // namespace
+
+ImageAidedPose::ImageAidedPose(const CameraIntrinsics& camera, const Mesh& proxy, const ImageAidedSettings& settings)
+    : camera_(camera), settings_(settings), fusion_(settings.fusion) {
+  if (proxy.triangle_count() == 0)
+    throw InputError("image-aided tracking needs the scene's proxy room: its corners' depth comes from it");
+  proxy_.add_static(proxy);
+  proxy_.commit();
+}
+
+std::optional<Pose> ImageAidedPose::update(const capture::Frame& frame, const std::optional<Pose>& tracker) {
+  if (frame.index == last_index_) return last_fused_;
+  if (frame.index != last_index_ + 1) {  // dropped frames or a seek: the corners are stale
+    corners_.clear();
+    points_.clear();
+    // After a few dropped frames the fused pose goes on with the tracker's motion; after a
+    // seek it starts again from the tracker.
+    if (frame.index <= last_index_ || frame.index > last_index_ + kMaxDroppedFrames) fusion_.reset();
+  }
+  cv::Mat grey;
+  cv::cvtColor(frame.image, grey, cv::COLOR_BGR2GRAY);
+  std::optional<Pose> visual;
+  tracked_.clear();
+  if (fusion_.pose() && !corners_.empty()) visual = pose_from_video(grey, *fusion_.pose(), tracker);
+  last_fused_ = fusion_.update(visual, tracker);
+  ++stats_.frames;
+  if (last_fused_)
+    anchor(grey, *last_fused_);
+  else
+    corners_.clear(), points_.clear();
+  last_grey_ = grey;
+  last_index_ = frame.index;
+  if (tracker) last_tracker_ = tracker;
+  return last_fused_;
+}
+
+std::optional<Pose> ImageAidedPose::pose_from_video(const cv::Mat& grey, const Pose& last,
+                                                    const std::optional<Pose>& tracker) {
+  std::vector<cv::Point2f> ahead, back;
+  std::vector<std::uint8_t> ok_ahead, ok_back;
+  std::vector<float> err;
+  const cv::Size window(21, 21);
+  cv::calcOpticalFlowPyrLK(last_grey_, grey, corners_, ahead, ok_ahead, err, window, 3);
+  cv::calcOpticalFlowPyrLK(grey, last_grey_, ahead, back, ok_back, err, window, 3);
+  std::vector<cv::Point2f> seen;
+  std::vector<cv::Point3f> points;
+  for (std::size_t i = 0; i < corners_.size(); ++i) {
+    const cv::Point2f d = back[i] - corners_[i];
+    if (ok_ahead[i] && ok_back[i] && d.dot(d) < 0.25f && ahead[i].x >= 0 && ahead[i].y >= 0 && ahead[i].x < grey.cols &&
+        ahead[i].y < grey.rows) {
+      seen.push_back(ahead[i]);
+      points.push_back(points_[i]);
+    }
+  }
+  if (static_cast<int>(seen.size()) < settings_.min_inliers) return std::nullopt;
+
+  // Start from the last pose moved as the tracker moved: RANSAC's models are then refined
+  // from near the answer.
+  Pose guess = last;
+  if (tracker && last_tracker_) guess = last * (last_tracker_->inverse() * *tracker);
+  cv::Vec3d rvec, tvec;
+  pose_to_opencv(guess, rvec, tvec);
+  std::vector<int> inliers;
+  const bool solved =
+      cv::solvePnPRansac(points, normalised(camera_, seen), cv::Matx33d::eye(), cv::noArray(), rvec, tvec, true, 100,
+                         float(settings_.ransac_px / camera_.fx), 0.999, inliers, cv::SOLVEPNP_ITERATIVE);
+  if (!solved || static_cast<int>(inliers.size()) < settings_.min_inliers) return std::nullopt;
+  // RANSAC only chooses the inliers. Its pose may be the mirror image that puts the points
+  // behind the camera (reprojection cannot tell them apart), so the pose is refined on the
+  // inliers from the guess, which is near the answer.
+  std::vector<cv::Point3f> in_points;
+  std::vector<cv::Point2f> in_seen;
+  for (int i : inliers) in_points.push_back(points[i]), in_seen.push_back(seen[i]);
+  pose_to_opencv(guess, rvec, tvec);
+  cv::solvePnPRefineLM(in_points, normalised(camera_, in_seen), cv::Matx33d::eye(), cv::noArray(), rvec, tvec);
+  const Pose pose = pose_from_opencv(rvec, tvec);
+  if (!pose.is_finite() || rotation_angle_deg(pose.rotation, guess.rotation) > settings_.max_disagree_deg)
+    return std::nullopt;
+  for (int i : inliers) tracked_.push_back(seen[i]);
+  stats_.inliers += (inliers.size() - stats_.inliers) / (++stats_.visual_frames);
+  return pose;
+}
+
+void ImageAidedPose::anchor(const cv::Mat& grey, const Pose& fused) {
+  std::vector<cv::Point2f> corners = tracked_;
+  // Fresh corners where the tracked ones have thinned out, away from those still held.
+  if (static_cast<int>(corners.size()) < settings_.max_corners * 2 / 3) {
+    const int spacing = std::max(8, grey.cols / 60);
+    cv::Mat free_area(grey.size(), CV_8U, cv::Scalar(255));
+    for (const auto& c : corners) cv::circle(free_area, c, spacing, cv::Scalar(0), -1);
+    std::vector<cv::Point2f> fresh;
+    cv::goodFeaturesToTrack(grey, fresh, settings_.max_corners - static_cast<int>(corners.size()), 0.01, spacing,
+                            free_area, 3);
+    corners.insert(corners.end(), fresh.begin(), fresh.end());
+  }
+  const std::vector<cv::Point2f> rays = normalised(camera_, corners);
+  corners_.clear();
+  points_.clear();
+  for (std::size_t i = 0; i < corners.size(); ++i) {
+    Ray ray;
+    const glm::dvec3 d = fused.rotation * glm::dvec3(rays[i].x, rays[i].y, 1.0);
+    ray.origin = glm::vec3(fused.translation);
+    ray.direction = glm::vec3(d);
+    const auto hit = proxy_.intersect(ray);
+    if (!hit || hit->back_face) continue;
+    // A grazing view of a surface puts a corner's depth far off for a small error.
+    if (std::abs(glm::dot(glm::normalize(glm::dvec3(ray.direction)), glm::dvec3(hit->normal))) < 0.15) continue;
+    const glm::dvec3 p = fused.translation + double(hit->t) * d;
+    corners_.push_back(corners[i]);
+    points_.emplace_back(float(p.x), float(p.y), float(p.z));
+  }
+}
+
+}  // namespace lumar::pipeline

@@ -1,0 +1,42 @@
+#pragma once
+// Fusing two estimates of the camera's pose: one precise from frame to frame but drifting
+// (the video's), one absolute but noisy (the tracker's). A complementary filter on
+// SO(3) x R^3: each frame the pose the video predicts is pulled towards the tracker's by
+// a small gain, so the fused pose takes its high frequencies from the video and its low
+// frequencies, and its absolute placement, from the tracker.
+//
+// With white tracker noise sigma_t per frame and a drift-free video, the settled error is
+// sigma_t * sqrt(g / (2 - g)) (g = the gain); a video drifting by d per frame adds about
+// d / g. Until 1/g frames have passed the gain is 1/(n + 1), the running mean of the
+// tracker's offset from the video's path, so that the start needs no settling.
+#include <optional>
+
+#include "lumar/base/pose.h"
+
+namespace lumar::tracking {
+
+struct PoseFusionSettings {
+  double tracker_gain = 0.05;  // (0, 1]; 1 = the tracker alone
+};
+
+class PoseFusion {
+ public:
+  explicit PoseFusion(const PoseFusionSettings& settings = {});
+
+  // One frame. `visual`: the camera's pose as the video continues it from the last fused
+  // pose (nullopt: the video could not tell; the tracker's own motion since its last
+  // sample stands in). `tracker`: the tracker's pose for the same frame (nullopt: none).
+  // Returns the fused pose; nullopt until the tracker has given one.
+  std::optional<Pose> update(const std::optional<Pose>& visual, const std::optional<Pose>& tracker);
+
+  // Forget everything (a seek, a gap in the frames): the next tracker pose starts again.
+  void reset();
+  const std::optional<Pose>& pose() const { return fused_; }
+
+ private:
+  PoseFusionSettings settings_;
+  std::optional<Pose> fused_, last_tracker_;
+  int tracker_frames_ = 0;
+};
+
+}  // namespace lumar::tracking
