@@ -22,7 +22,7 @@ namespace lumar::app {
 namespace {
 
 struct OverlayOptions {
-  std::string recording, scene, out, frames_dir, contact_sheet, poses = "tracker", undistort = "same";
+  std::string recording, scene, out, frames_dir, contact_sheet, poses = "fused", undistort = "same";
   std::string filter = "none", without;
   double blur_sigma = -1.0;
   bool window = false, no_cache = false, allow_incomplete = false, paused = false;
@@ -95,8 +95,7 @@ void run_live(OverlayOptions& o) {
   if (!o.recording.empty()) throw InputError("overlay: give --recording or --source, not both");
   if (!o.contact_sheet.empty()) throw InputError("--contact-sheet: a live run has no known length; use --frames-dir");
   if (o.poses == "truth") throw InputError("--poses truth: a live source has no ground truth");
-  if (o.poses == "fused")
-    throw InputError("--poses fused: steadying by the video is for recordings so far; use tracker");
+  o.live.steady_with_video = o.poses == "fused";
   pipeline::LiveOverlayOptions& live = o.live;
   live.scene = o.scene;
   live.max_frames = o.max_frames;
@@ -194,7 +193,8 @@ void register_overlay(CLI::App& app) {
   cmd->add_option("--frames-dir", o->frames_dir, "Also write every output frame as PNG into this new folder");
   cmd->add_option("--contact-sheet", o->contact_sheet, "Also write 8 frames spread over the run, tiled, as one PNG");
   cmd->add_option("--poses", o->poses,
-                  "Camera poses: the tracker stream, the tracker steadied by the video (fused), or the recording's "
+                  "Camera poses: the tracker stream steadied by the video (fused, the default), the tracker stream "
+                  "alone, or the recording's "
                   "ground truth")
       ->check(CLI::IsMember({"tracker", "fused", "truth"}))
       ->capture_default_str();

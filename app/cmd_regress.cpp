@@ -2,6 +2,7 @@
 // expected results (golden frames, where the virtual object projects).
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
+#include <cmath>
 #include <fstream>
 #include <memory>
 #include <nlohmann/json.hpp>
@@ -217,11 +218,22 @@ Outcome regress_one(const fs::path& dir, const RegressOptions& o) {
       tracked_limit, render_error, render_samples, render_limit,
       tracked.px.size() == frames.size() ? ""
                                          : fmt::format("; {} frames lacked a pose", frames.size() - tracked.px.size()));
+  // Frames where the video's help made things worse than the tracker alone by over 1 px.
+  int worse = 0;
+  for (std::size_t k = 0; k < std::min(tracked.px.size(), fused.px.size()); ++k)
+    worse += fused.px[k] > tracked.px[k] + 1;
+  const auto motion = [](const pipeline::RegistrationError& e) {
+    std::string s;
+    if (!std::isnan(e.jitter_px)) s += fmt::format(", jitter at rest {:.2f} px", e.jitter_px);
+    if (!std::isnan(e.lag_ms)) s += fmt::format(", lag {:.1f} ms", e.lag_ms);
+    if (!std::isnan(e.overshoot_px)) s += fmt::format(", overshoot {:.2f} px", e.overshoot_px);
+    return s;
+  };
   out.line += fmt::format(
-      "\n  registration: tracker mean {:.2f} px, p95 {:.2f} px; steadied by the video (--poses fused) mean {:.2f} px, "
-      "p95 {:.2f} px, worst frame {:.2f} px{}",
-      tracked.mean, tracked.p95, fused.mean, fused.p95, fused.worst,
-      fused_limit < 1e9 ? fmt::format(" (mean <= {:.1f})", fused_limit) : std::string());
+      "\n  registration: tracker mean {:.2f} px, p95 {:.2f} px{}; steadied by the video (--poses fused) mean {:.2f} "
+      "px, p95 {:.2f} px, worst frame {:.2f} px{}{}; {} frames worse than the tracker by over 1 px",
+      tracked.mean, tracked.p95, motion(tracked), fused.mean, fused.p95, fused.worst, motion(fused),
+      fused_limit < 1e9 ? fmt::format(" (mean <= {:.1f})", fused_limit) : std::string(), worse);
   out.record = {{"recording", dir.string()},
                 {"pass", out.pass},
                 {"frames", frames.size()},
@@ -231,7 +243,14 @@ Outcome regress_one(const fs::path& dir, const RegressOptions& o) {
                 {"tracker_p95_px", tracked.p95},
                 {"fused_mean_px", fused.mean},
                 {"fused_p95_px", fused.p95},
+                {"frames_fused_worse_than_tracker", worse},
                 {"render_projection_mean_px", render_error}};
+  const auto number = [](double x) { return std::isnan(x) ? json(nullptr) : json(x); };
+  for (const auto& [name, e] : {std::pair{"tracker", &tracked}, std::pair{"fused", &fused}}) {
+    out.record[std::string(name) + "_jitter_px"] = number(e->jitter_px);
+    out.record[std::string(name) + "_lag_ms"] = number(e->lag_ms);
+    out.record[std::string(name) + "_overshoot_px"] = number(e->overshoot_px);
+  }
   for (const char* key : {"object_err", "edge_err", "shadow_err", "noise_ratio", "noise_floor_object_err",
                           "noise_floor_edge_err", "noise_floor_shadow_err", "all_off_object_err", "all_off_edge_err",
                           "all_off_shadow_err", "all_off_noise_ratio", "specks"})

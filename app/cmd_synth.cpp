@@ -60,9 +60,26 @@ void register_synth(CLI::App& app) {
   cmd->add_option("--latency-ms", s->latency_ms, "Tracker latency in milliseconds")->capture_default_str();
   cmd->add_option("--arc-deg", s->arc_deg, "How far the camera orbits the object, degrees")->capture_default_str();
   cmd->add_option("--path", s->path,
-                  "The camera's path: orbit, still (held where the orbit ends), or room (standing back, turning slowly "
-                  "across the object to the far wall)")
-      ->check(CLI::IsMember({"orbit", "still", "room"}))
+                  "The camera's path: orbit, still (held where the orbit ends), room (standing back, turning slowly "
+                  "across the object to the far wall), or rest-turn (held 2 s, turning at 30 deg/s for 1 s, held)")
+      ->check(CLI::IsMember({"orbit", "still", "room", "rest-turn"}))
+      ->capture_default_str();
+  cmd->add_flag("--room-differs", s->room_differs,
+                "The video shows a room unlike the scene's proxy: a wall 3 cm off, a cabinet, a table, a box "
+                "(the overlay still gets the proxy)");
+  // What goes wrong with a real camera's video (sim/video_faults.h).
+  auto drop = std::make_shared<std::vector<int>>(), flat = std::make_shared<std::vector<int>>(),
+       occluder = std::make_shared<std::vector<int>>();
+  cmd->add_option("--drop-frames", *drop, "Leave COUNT frames from frame FROM out of the video: FROM COUNT")
+      ->expected(2);
+  cmd->add_option("--textureless", *flat, "A flat wall fills the view for COUNT frames from frame FROM: FROM COUNT")
+      ->expected(2);
+  cmd->add_option("--occluder", *occluder,
+                  "A textured panel half the frame wide slides across the view over COUNT frames from FROM: FROM COUNT")
+      ->expected(2);
+  cmd->add_option("--motion-blur", s->faults.motion_blur_s,
+                  "Shutter time in seconds: each frame is blurred by the "
+                  "camera's motion over it (0: none)")
       ->capture_default_str();
   cmd->add_option("--codec", s->codec, "Video codec: mjpeg (near-lossless) or ffv1 (lossless)")
       ->check(CLI::IsMember({"mjpeg", "ffv1"}))
@@ -103,8 +120,11 @@ void register_synth(CLI::App& app) {
   cmd->add_option("--image-noise", b->image_noise, "--board: image noise, 8-bit levels RMS")->capture_default_str();
   auto sweep = std::make_shared<SweepOptions>();
   add_sweep_options(cmd, *sweep);
-  add_action(cmd, [cmd, s, camera_file, b, board, sweep, change_box, change_scale, change] {
+  add_action(cmd, [cmd, s, camera_file, b, board, sweep, change_box, change_scale, change, drop, flat, occluder] {
     catch_stop_signals();  // Ctrl-C stops between frames; the unfinished recording is removed
+    for (auto [from, range] : {std::pair{drop, &s->faults.dropped}, std::pair{flat, &s->faults.textureless},
+                               std::pair{occluder, &s->faults.occluder}})
+      if (!from->empty()) *range = sim::FrameRange{(*from)[0], (*from)[1]};
     if (change_box->empty() != change_scale->empty())
       throw InputError("synth: --change-box and --change-scale go together");
     if (!change_box->empty()) {

@@ -136,12 +136,23 @@ assert r["fused_p95_px"] < r["tracker_p95_px"]
 PY
 }
 
-case_overlay_fused_poses() {
-  # The same frames with the tracker's poses steadied by the video; a live source refuses it.
-  "$LUMAR" overlay --recording "$REC" --poses fused --max-frames 4 --frames-dir "$TMP/fused" >"$TMP/log" 2>&1 ||
-    { cat "$TMP/log"; fail "overlay --poses fused failed"; }
-  [ "$(ls "$TMP/fused" | grep -c png)" -eq 4 ] || fail "expected 4 frames"
-  expect_bad_input "--poses fused" "" -- "$LUMAR" overlay --source "recording:$REC" --poses fused --scene \
+case_overlay_pose_sources() {
+  # fused (the default), tracker and truth give the same first frame (the fused pose
+  # starts as the tracker's) and then differ; a live source has no truth.
+  local p
+  for p in fused tracker truth; do
+    "$LUMAR" overlay --recording "$REC" --poses $p --max-frames 6 --frames-dir "$TMP/$p" >"$TMP/log" 2>&1 ||
+      { cat "$TMP/log"; fail "overlay --poses $p failed"; }
+    [ "$(ls "$TMP/$p" | grep -c png)" -eq 6 ] || fail "expected 6 frames with --poses $p"
+  done
+  "$LUMAR" overlay --recording "$REC" --max-frames 6 --frames-dir "$TMP/default" >"$TMP/log" 2>&1 || fail "default"
+  cmp -s "$TMP/default/$(ls "$TMP/default" | tail -1)" "$TMP/fused/$(ls "$TMP/fused" | tail -1)" ||
+    fail "the default is not --poses fused"
+  cmp -s "$TMP/fused/$(ls "$TMP/fused" | head -1)" "$TMP/tracker/$(ls "$TMP/tracker" | head -1)" ||
+    fail "the first fused frame is not the tracker's"
+  ! cmp -s "$TMP/fused/$(ls "$TMP/fused" | tail -1)" "$TMP/tracker/$(ls "$TMP/tracker" | tail -1)" ||
+    fail "the video's help changed nothing"
+  expect_bad_input "--poses truth" "" -- "$LUMAR" overlay --source "recording:$REC" --poses truth --scene \
     "$SRC/data/scenes/room/scene.json"
 }
 

@@ -1,99 +1,162 @@
-// Image-aided tracking on the shipped synthetic recordings, against their true poses.
-// The registration error is measured as `lumar regress` measures it: where the objects'
-// points project with a pose against with the true one (pipeline::projection_error_px).
+// Image-aided tracking on synthetic recordings, against their true poses: the shipped
+// orbit and walk, and more made here: a room unlike the proxy the overlay is given (a low
+// table, a box, a cabinet, a wall 3 cm off), a rest-then-turn (held 2 s, 30 deg/s for 1 s,
+// held), and what goes wrong with video: ten dropped frames, a textureless view, a panel
+// sliding across half the view, motion blur. The tracker has 0.75 deg / 2.5 mm noise and 20 ms
+// latency in all of them. Registration is measured as `lumar regress` measures it
+// (pipeline::registration_error).
 #include <gtest/gtest.h>
 
-#include <algorithm>
-#include <cmath>
 #include <cstdio>
 #include <functional>
 
+#include "lumar/calib/camera_file.h"
 #include "lumar/capture/recording_replay.h"
 #include "lumar/pipeline/image_aided_pose.h"
 #include "lumar/pipeline/registration_error.h"
 #include "lumar/scene/loaded_scene.h"
+#include "lumar/sim/synthetic_recording.h"
 #include "test_paths.h"
 
 namespace lumar {
 namespace {
 
-struct Errors {
-  std::vector<double> px;  // per frame
-  double mean() const {
-    double s = 0;
-    for (double e : px) s += e;
-    return px.empty() ? 0 : s / px.size();
-  }
-  double worst() const { return px.empty() ? 0 : *std::max_element(px.begin(), px.end()); }
-  double p95() const {
-    std::vector<double> s = px;
-    std::sort(s.begin(), s.end());
-    return s.empty() ? 0 : s[std::size_t(std::ceil(0.95 * s.size())) - 1];
-  }
+std::filesystem::path synthesize(const std::string& name, const std::function<void(sim::SynthSettings&)>& change) {
+  static const test::Scratch scratch("image-aided-pose");
+  sim::SynthSettings s;
+  s.scene = test::source_dir() / "data/scenes/room/scene.json";
+  s.out = scratch.dir / name;
+  s.camera = calib::load_camera_file(test::source_dir() / "data/camera/webcam-640x480.yml").intrinsics;
+  s.supersample = 1;
+  change(s);
+  sim::synthesize_recording(s);
+  return s.out;
+}
+
+struct Both {
+  pipeline::RegistrationError tracker, fused;
+  int worse = 0;  // frames where the fused pose is worse than the tracker's by over 1 px
 };
 
-// Every frame of `name` through ImageAidedPose with `tracker(frame)` as the tracker's pose.
-Errors run(const std::string& name, const std::function<std::optional<Pose>(const capture::Frame&)>& tracker,
-           const pipeline::ImageAidedSettings& settings = {}, pipeline::ImageAidedPose::Stats* stats = nullptr) {
-  const capture::RecordingReplay replay(test::source_dir() / "recordings" / name);
-  const LoadedScene scene = load_scene_files(replay.scene_path());
-  pipeline::ImageAidedPose fused(replay.session().camera, scene.room, settings);
-  const CameraIntrinsics pinhole = replay.session().camera.without_distortion();
-  auto frames = replay.open_frames();
-  capture::Frame frame;
-  Errors out;
-  while (frames->read(frame)) {
-    const auto pose = fused.update(frame, tracker(frame));
-    const auto truth = replay.true_camera_pose(frame.index);
-    std::vector<glm::dvec3> points;
-    for (const auto& o : scene.objects) {
-      const glm::dmat4 T = o.pose_at(nanos_to_seconds(frame.time));
-      for (std::size_t i = 0; i < o.model.positions.size(); i += 97)
-        points.emplace_back(T * glm::dvec4(glm::dvec3(o.model.positions[i]), 1.0));
+Both measure(const std::filesystem::path& recording) {
+  pipeline::ReplayOverlay overlay(recording);
+  Both b{pipeline::registration_error(overlay, pipeline::PoseSource::Tracker),
+         pipeline::registration_error(overlay, pipeline::PoseSource::Fused)};
+  std::string which;
+  for (std::size_t k = 0; k < b.fused.px.size(); ++k)
+    if (b.fused.px[k] > b.tracker.px[k] + 1.0) {
+      char line[64];
+      std::snprintf(line, sizeof line, " %zu (%.2f against %.2f)", k, b.fused.px[k], b.tracker.px[k]);
+      ++b.worse, which += line;
     }
-    if (pose && truth) out.px.push_back(pipeline::projection_error_px(pinhole, points, *pose, *truth));
-  }
-  if (stats) *stats = fused.stats();
-  return out;
+  std::printf(
+      "%s: tracker mean %.2f px, p95 %.2f; fused mean %.2f px, p95 %.2f, jitter %.2f px, lag %.1f ms, "
+      "overshoot %.2f px (tracker: %.2f px, %.1f ms, %.2f px); %d frames worse by over 1 px:%s\n",
+      recording.filename().c_str(), b.tracker.mean, b.tracker.p95, b.fused.mean, b.fused.p95, b.fused.jitter_px,
+      b.fused.lag_ms, b.fused.overshoot_px, b.tracker.jitter_px, b.tracker.lag_ms, b.tracker.overshoot_px, b.worse,
+      which.c_str());
+  EXPECT_EQ(b.fused.px.size(), b.tracker.px.size());
+  return b;
 }
 
 // The video alone: the true pose for the first frame, no tracker after it. What is left is
 // the drift of the chain of frame-to-frame poses from the corners on the proxy.
 TEST(ImageAidedPose, TheVideoAloneFollowsTheCameraFromItsFirstPose) {
+  const capture::RecordingReplay replay(test::source_dir() / "recordings/orbit");
+  const LoadedScene scene = load_scene_files(replay.scene_path());
+  pipeline::ImageAidedPose fused(replay.session().camera, scene.room);
+  const CameraIntrinsics pinhole = replay.session().camera.without_distortion();
+  std::vector<glm::dvec3> points;
+  for (std::size_t i = 0; i < scene.objects[0].model.positions.size(); i += 97)
+    points.emplace_back(scene.objects[0].T_world_model *
+                        glm::dvec4(glm::dvec3(scene.objects[0].model.positions[i]), 1.0));
+  auto frames = replay.open_frames();
+  capture::Frame frame;
+  double sum = 0, last = 0;
+  int n = 0;
+  while (frames->read(frame)) {
+    const auto truth = replay.true_camera_pose(frame.index);
+    const auto pose = fused.update(frame, frame.index == 0 ? truth : std::nullopt);
+    ASSERT_TRUE(pose && truth);
+    last = pipeline::projection_error_px(pinhole, points, *pose, *truth), sum += last, ++n;
+  }
+  std::printf(
+      "the video alone from the true first pose: mean %.2f px, last frame %.2f px over %d frames; %.0f "
+      "inliers\n",
+      sum / n, last, n, fused.stats().inliers);
+  EXPECT_EQ(fused.stats().visual_frames, n - 1);
+  EXPECT_LT(sum / n, 0.5);
+  EXPECT_LT(last, 1.0);
+}
+
+// The shipped recordings: the tracker's 4.6-5.1 px to about 1 px, the mean of the tracker's
+// first samples being all there is at the start (the first frame is the tracker's).
+TEST(ImageAidedPose, SteadiesTheTrackerOnTheSampleRecordings) {
   for (const char* name : {"orbit", "walk"}) {
-    const capture::RecordingReplay replay(test::source_dir() / "recordings" / name);
-    pipeline::ImageAidedPose::Stats stats;
-    const Errors video = run(
-        name,
-        [&](const capture::Frame& f) { return f.index == 0 ? replay.true_camera_pose(0) : std::optional<Pose>(); }, {},
-        &stats);
-    std::printf(
-        "%s, the video alone from the true first pose: mean %.2f px, last frame %.2f px; %d of %d frames, %.0f "
-        "inliers\n",
-        name, video.mean(), video.px.back(), stats.visual_frames, stats.frames, stats.inliers);
-    EXPECT_EQ(stats.visual_frames, stats.frames - 1);
-    EXPECT_LT(video.mean(), 1.0) << name;
+    const Both b = measure(test::source_dir() / "recordings" / name);
+    EXPECT_LT(b.fused.mean, 1.1) << name;
+    EXPECT_LT(b.fused.mean, 0.25 * b.tracker.mean) << name;
+    EXPECT_NEAR(b.fused.px[0], b.tracker.px[0], 1e-9) << "the first frame is the tracker's";
+    EXPECT_LE(b.worse, 2) << name;
   }
 }
 
-// The tracker's poses steadied by the video, against the tracker's alone.
-TEST(ImageAidedPose, SteadiesTheTrackersPosesOnTheSampleRecordings) {
-  for (const char* name : {"orbit", "walk"}) {
-    const capture::RecordingReplay replay(test::source_dir() / "recordings" / name);
-    const auto tracker = [&](const capture::Frame& f) { return replay.tracked_camera_pose(f.time); };
-    const Errors alone = run(name, [&](const capture::Frame& f) { return replay.tracked_camera_pose(f.time); },
-                             {.fusion = {.tracker_gain = 1.0}});
-    const Errors fused = run(name, tracker);
-    // Settled: the last second. The first frames can be no better than the mean of the
-    // tracker's samples so far (sigma / sqrt(n)), since nothing else is absolute.
-    double settled = 0;
-    for (std::size_t i = fused.px.size() - 24; i < fused.px.size(); ++i) settled += fused.px[i] / 24;
-    std::printf("%s: tracker alone mean %.2f px, p95 %.2f px; fused mean %.2f px, p95 %.2f px, last second %.2f px\n",
-                name, alone.mean(), alone.p95(), fused.mean(), fused.p95(), settled);
-    EXPECT_LT(fused.mean(), 1.1) << name;
-    EXPECT_LT(fused.mean(), 0.3 * alone.mean()) << name;
-    EXPECT_LT(settled, 0.5) << name;
-    EXPECT_LE(fused.px[0], alone.px[0] + 1e-9) << "the first frame is the tracker's";
+// The video shows a low table, a box and a cabinet the proxy does not have, and a wall 3 cm
+// further back: the corners on them get the wrong depth, and RANSAC must leave them out.
+TEST(ImageAidedPose, HoldsInARoomUnlikeTheProxy) {
+  const Both b = measure(synthesize("room-differs", [](sim::SynthSettings& s) { s.room_differs = true; }));
+  EXPECT_LT(b.fused.mean, 1.2);
+  EXPECT_LT(b.fused.mean, 0.3 * b.tracker.mean);
+  EXPECT_LE(b.worse, 2);
+}
+
+// Held 2 s, turned at 30 deg/s for 1 s, held: the jitter, lag and overshoot.
+TEST(ImageAidedPose, RestThenTurnNeitherJittersNorLagsNorOvershoots) {
+  const Both b = measure(synthesize("rest-turn", [](sim::SynthSettings& s) {
+    s.path = "rest-turn";
+    s.frames = 108;
+    s.fps = 24;
+  }));
+  EXPECT_LT(b.fused.jitter_px, 0.3);
+  EXPECT_LT(std::abs(b.fused.lag_ms), 5.0);
+  EXPECT_LT(b.fused.overshoot_px, 1.0);
+  EXPECT_GT(b.tracker.jitter_px, 3.0);  // what it steadies
+  EXPECT_LT(b.fused.mean, 1.0);
+}
+
+// Ten frames missing: the video cannot bridge 12.8 degrees of turn on the rug's stripes,
+// the tracker's motion does, and the fused pose then trusts the tracker as at the start.
+TEST(ImageAidedPose, BridgesTenDroppedFrames) {
+  const auto recording = synthesize("dropped", [](sim::SynthSettings& s) { s.faults.dropped = {20, 10}; });
+  ASSERT_EQ(capture::RecordingReplay(recording).reader().frames().size(), 38u);
+  const Both b = measure(recording);
+  EXPECT_LT(b.fused.mean, 1.6);
+  EXPECT_LT(b.fused.mean, 0.4 * b.tracker.mean);
+  EXPECT_LE(b.worse, 3);
+}
+
+// The video cannot tell for half a second (a flat wall), or half of it moves on its own (a
+// panel walking through), or every frame is smeared by a full frame period of motion
+// (about 1.3 degrees, 12 px): no frame is worse than the tracker's by over 1 px except at
+// the start, where the mean of a few tracker samples can lose to a lucky one (frames 3
+// and 7 here, the same in every recording of this path and seed).
+TEST(ImageAidedPose, DegradesGracefully) {
+  const std::vector<std::pair<std::string, std::function<void(sim::SynthSettings&)>>> cases{
+      {"textureless",
+       [](sim::SynthSettings& s) {
+         s.faults.textureless = {16, 12};
+       }},
+      {"occluder",
+       [](sim::SynthSettings& s) {
+         s.faults.occluder = {12, 24};
+       }},
+      {"motion-blur", [](sim::SynthSettings& s) { s.faults.motion_blur_s = 1.0 / 24; }}};
+  for (const auto& [name, change] : cases) {
+    const Both b = measure(synthesize(name, change));
+    EXPECT_LT(b.fused.mean, 0.35 * b.tracker.mean) << name;
+    EXPECT_LT(b.fused.mean, 1.5) << name;
+    for (std::size_t k = 8; k < b.fused.px.size(); ++k)
+      EXPECT_LE(b.fused.px[k], b.tracker.px[k] + 1.0) << name << ", frame " << k;
   }
 }
 

@@ -54,12 +54,14 @@ ImageAidedPose::ImageAidedPose(const CameraIntrinsics& camera, const Mesh& proxy
 
 std::optional<Pose> ImageAidedPose::update(const capture::Frame& frame, const std::optional<Pose>& tracker) {
   if (frame.index == last_index_) return last_fused_;
-  if (frame.index != last_index_ + 1) {  // dropped frames or a seek: the corners are stale
+  // After a seek the fused pose starts again from the tracker. Over dropped frames the
+  // corners are looked for where the tracker's motion since the last frame puts them.
+  if (frame.index <= last_index_ || frame.index > last_index_ + kMaxDroppedFrames) {
+    fusion_.reset();
     corners_.clear();
     points_.clear();
-    // After a few dropped frames the fused pose goes on with the tracker's motion; after a
-    // seek it starts again from the tracker.
-    if (frame.index <= last_index_ || frame.index > last_index_ + kMaxDroppedFrames) fusion_.reset();
+  } else if (frame.index > last_index_ + 1) {
+    fusion_.restart_mean();
   }
   cv::Mat grey;
   cv::cvtColor(frame.image, grey, cv::COLOR_BGR2GRAY);
@@ -80,11 +82,20 @@ std::optional<Pose> ImageAidedPose::update(const capture::Frame& frame, const st
 
 std::optional<Pose> ImageAidedPose::pose_from_video(const cv::Mat& grey, const Pose& last,
                                                     const std::optional<Pose>& tracker) {
+  // Start from the last pose moved as the tracker moved: each corner is looked for where
+  // its point projects from there, and PnP is refined from there.
+  Pose guess = last;
+  if (tracker && last_tracker_) guess = last * (last_tracker_->inverse() * *tracker);
+  cv::Vec3d rvec, tvec;
+  pose_to_opencv(guess, rvec, tvec);
   std::vector<cv::Point2f> ahead, back;
+  cv::projectPoints(points_, rvec, tvec, cv::Mat(camera_.camera_matrix()), camera_.distortion_coefficients(), ahead);
   std::vector<std::uint8_t> ok_ahead, ok_back;
   std::vector<float> err;
   const cv::Size window(21, 21);
-  cv::calcOpticalFlowPyrLK(last_grey_, grey, corners_, ahead, ok_ahead, err, window, 3);
+  const cv::TermCriteria stop(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, 30, 0.01);
+  cv::calcOpticalFlowPyrLK(last_grey_, grey, corners_, ahead, ok_ahead, err, window, 3, stop,
+                           cv::OPTFLOW_USE_INITIAL_FLOW, settings_.min_eigen);
   cv::calcOpticalFlowPyrLK(grey, last_grey_, ahead, back, ok_back, err, window, 3);
   std::vector<cv::Point2f> seen;
   std::vector<cv::Point3f> points;
@@ -98,12 +109,6 @@ std::optional<Pose> ImageAidedPose::pose_from_video(const cv::Mat& grey, const P
   }
   if (static_cast<int>(seen.size()) < settings_.min_inliers) return std::nullopt;
 
-  // Start from the last pose moved as the tracker moved: RANSAC's models are then refined
-  // from near the answer.
-  Pose guess = last;
-  if (tracker && last_tracker_) guess = last * (last_tracker_->inverse() * *tracker);
-  cv::Vec3d rvec, tvec;
-  pose_to_opencv(guess, rvec, tvec);
   std::vector<int> inliers;
   const bool solved =
       cv::solvePnPRansac(points, normalised(camera_, seen), cv::Matx33d::eye(), cv::noArray(), rvec, tvec, true, 100,

@@ -62,6 +62,14 @@ LiveOverlay::LiveOverlay(const LiveOverlayOptions& o) {
   settings.max_frames = o.max_frames;
   settings.filter = o.filter;
   loop_ = std::make_unique<LiveLoop>(std::move(live.source), std::move(driver), rig, settings);
+  if (o.steady_with_video) {
+    if (overlay_->scene().room.triangle_count() > 0)
+      fused_ = std::make_unique<ImageAidedPose>(camera, overlay_->scene().room);
+    else
+      spdlog::warn(
+          "the scene has no proxy room, which the video's corners need for their depth: the tracker's "
+          "poses are used as they are");
+  }
   if (recorded) loop_->use_recorded_poses(recorded);
 }
 
@@ -69,8 +77,12 @@ void LiveOverlay::run(const std::function<bool(const OverlayFrame&)>& sink) {
   StageTimes& times = overlay_->times();
   loop_->run(
       [&](capture::PairedFrame& paired) {
-        const OverlayFrame out = overlay_->composite(paired.frame, paired.T_world_camera);
-        const auto t0 = std::chrono::steady_clock::now();
+        auto t0 = std::chrono::steady_clock::now();
+        const std::optional<Pose> pose =
+            fused_ ? fused_->update(paired.frame, paired.T_world_camera) : paired.T_world_camera;
+        times.pose += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+        const OverlayFrame out = overlay_->composite(paired.frame, pose);
+        t0 = std::chrono::steady_clock::now();
         const bool go_on = sink(out);
         times.output += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
         times.latency += nanos_to_seconds(monotonic_now() - paired.frame.time) * 1e3;  // capture to handed on

@@ -1,5 +1,7 @@
 #include "lumar/pipeline/replay_overlay.h"
 
+#include <spdlog/spdlog.h>
+
 #include <chrono>
 
 #include "lumar/base/error.h"
@@ -37,6 +39,12 @@ void ReplayOverlay::set_pose_filter(const std::optional<tracking::PoseFilterSett
 void ReplayOverlay::set_pose_source(PoseSource source) {
   if (source == PoseSource::Truth && replay_.reader().truth().empty())
     throw InputError("this recording has no ground truth (truth.csv); use the tracker's poses");
+  if (source == PoseSource::Fused && scene().room.triangle_count() == 0) {
+    spdlog::warn(
+        "the scene has no proxy room, which the video's corners need for their depth: the tracker's poses "
+        "are used as they are");
+    source = PoseSource::Tracker;
+  }
   pose_source_ = source;
   fused_.reset();
   if (source == PoseSource::Fused) fused_ = std::make_unique<ImageAidedPose>(replay_.session().camera, scene().room);

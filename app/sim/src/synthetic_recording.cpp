@@ -22,6 +22,7 @@
 #include "lumar/render/renderer.h"
 #include "lumar/scene/loaded_scene.h"
 #include "lumar/sim/envmap_view.h"
+#include "lumar/sim/furnished_room.h"
 #include "lumar/sim/truth_frame.h"
 #include "lumar/tracking/simulated_tracker.h"
 #include "lumar/tracking/tracker_stream.h"
@@ -65,7 +66,8 @@ void write_tracker_stream(capture::RecordingWriter& writer, const tracking::Simu
 void write_synthetic_recording(const std::filesystem::path& out, const capture::Session& session,
                                const tracking::SimulatedTrackerOutput& tracker, const capture::RecordingSettings& video,
                                int frames, std::uint64_t seed, const std::function<Nanos(int)>& frame_time,
-                               const std::function<Pose(Nanos)>& true_camera, const SyntheticFrameRenderer& render) {
+                               const std::function<Pose(Nanos)>& true_camera, const SyntheticFrameRenderer& render,
+                               const std::function<bool(int)>& dropped) {
   try {
     capture::RecordingWriter writer(out, capture::session_to_json(session), video);
     write_tracker_stream(writer, tracker, session.tracker, session.rig.latency);
@@ -74,6 +76,7 @@ void write_synthetic_recording(const std::filesystem::path& out, const capture::
       if (stop_requested())
         throw Interrupted(
             fmt::format("synth: at frame {} of {}; {} removed, as an unfinished recording", k, frames, out.string()));
+      if (dropped && dropped(k)) continue;
       const Nanos t = frame_time(k);
       const Pose T_world_camera = true_camera(t);
       writer.add_frame(capture::Frame{render(k, t, T_world_camera, rng), t, k});
@@ -183,9 +186,14 @@ capture::SynthInfo synth_info(const SynthSettings& s) {
   return synth;
 }
 
-Pose synth_camera_pose(const std::string& path, const glm::dvec3& target, double s, double arc_deg) {
+Pose synth_camera_pose(const std::string& path, const glm::dvec3& target, double s, double t_s, double arc_deg) {
   if (path == "orbit") return orbit_camera_pose(target, s, arc_deg);
   if (path == "still") return orbit_camera_pose(target, 1.0, arc_deg);
+  if (path == "rest-turn") {
+    const Pose rest = orbit_camera_pose(target, 0.5, arc_deg);
+    const double turned = kRestTurnDegPerS * (std::clamp(t_s, kRestTurnStartS, kRestTurnEndS) - kRestTurnStartS);
+    return Pose{axis_angle_deg({0, 1, 0}, turned) * rest.rotation, rest.translation};
+  }
   if (path == "room") {
     // Standing back at the room's far side, turning slowly across the object to the far
     // wall and up, so that the room's lights and window come into view beside the object.
@@ -194,7 +202,7 @@ Pose synth_camera_pose(const std::string& path, const glm::dvec3& target, double
     const glm::dvec3 look(std::cos(pitch) * std::cos(yaw), std::sin(pitch), -std::cos(pitch) * std::sin(yaw));
     return look_at(eye, eye + look);
   }
-  throw InputError("--path " + path + ": unknown camera path; use orbit, still or room");
+  throw InputError("--path " + path + ": unknown camera path; use orbit, still, room or rest-turn");
 }
 
 std::vector<SynthSettings> sample_room_light_changes(const std::filesystem::path& scene, const CameraIntrinsics& camera,
@@ -232,7 +240,7 @@ void synthesize_recording(const SynthSettings& s) {
   auto context = gl::create_headless_context();
   const CameraIntrinsics pinhole = covering_pinhole(s.camera, s.supersample);
   gl::Renderer renderer(pinhole);
-  renderer.set_room(scene.room);
+  renderer.set_room(s.room_differs ? furnished_room(scene.room) : scene.room);
   renderer.set_environment(scene.map);
   std::optional<EnvironmentMap> changed_map;
   if (s.light_change) {
@@ -260,9 +268,20 @@ void synthesize_recording(const SynthSettings& s) {
   const Nanos frame_period = seconds_to_nanos(1.0 / s.fps);
   const Nanos duration = start + frame_period * s.frames + seconds_to_nanos(0.1);
   const double clip_seconds = nanos_to_seconds(frame_period * (s.frames - 1));
+  if (s.path == "rest-turn" && clip_seconds < kRestTurnEndS + 0.5)
+    throw InputError(fmt::format("--path rest-turn: the recording lasts {:.2f} s; it needs {:.1f} s (--frames / --fps)",
+                                 clip_seconds, kRestTurnEndS + 0.5));
+  for (const auto& [name, range] :
+       {std::pair{"--drop-frames", s.faults.dropped}, std::pair{"--textureless", s.faults.textureless},
+        std::pair{"--occluder", s.faults.occluder}})
+    if (range.from < 0 || range.count < 0 ||
+        (!range.empty() && (range.from == 0 || range.from + range.count >= s.frames)))
+      throw InputError(std::string(name) + ": FROM COUNT must lie within the frames and leave the first and the last");
+  if (!(s.faults.motion_blur_s >= 0.0) || s.faults.motion_blur_s * s.fps > 1.0)
+    throw InputError("--motion-blur: the shutter time must be from 0 to one frame period");
   auto true_camera = [&](Nanos t) {
     const double u = std::clamp(nanos_to_seconds(t - start) / clip_seconds, 0.0, 1.0);
-    return synth_camera_pose(s.path, target, u, s.arc_deg);
+    return synth_camera_pose(s.path, target, u, nanos_to_seconds(t - start), s.arc_deg);
   };
 
   const auto tracker = simulate_session_tracker(
@@ -299,6 +318,8 @@ void synthesize_recording(const SynthSettings& s) {
   TruthSettings truth_settings;
   truth_settings.ratio_stride = s.truth_ratio_stride;
 
+  const cv::Mat occluder =
+      s.faults.occluder.empty() ? cv::Mat() : occluder_texture(cv::Size(pinhole.width, pinhole.height));
   const capture::RecordingSettings video{
       .codec = s.codec, .quality = s.quality, .fps = s.fps, .size = cv::Size(s.camera.width, s.camera.height)};
   write_synthetic_recording(
@@ -309,7 +330,17 @@ void synthesize_recording(const SynthSettings& s) {
           if (w != shown_weight) renderer.set_environment(blend_environment_maps(scene.map, *changed_map, w));
           shown_weight = w;
         }
-        const cv::Mat radiance = renderer.render_room_radiance(pinhole, T_world_camera);
+        cv::Mat radiance = renderer.render_room_radiance(pinhole, T_world_camera);
+        if (s.faults.motion_blur_s > 0) {  // the shutter open around t
+          radiance /= double(VideoFaults::kBlurSamples);
+          for (int i = 0; i < VideoFaults::kBlurSamples; ++i) {
+            if (2 * i + 1 == VideoFaults::kBlurSamples) continue;  // the middle one is above
+            const double at = ((i + 0.5) / VideoFaults::kBlurSamples - 0.5) * s.faults.motion_blur_s;
+            radiance += renderer.render_room_radiance(pinhole, true_camera(t + seconds_to_nanos(at))) /
+                        double(VideoFaults::kBlurSamples);
+          }
+        }
+        apply_video_faults(s.faults, k, occluder, radiance);
         // The video's own noise, drawn again for the truth, so that only the objects differ.
         cv::RNG same_noise = rng;
         const cv::Mat video = expose(calib::distort_image(radiance, pinhole, s.camera), s.camera, s, exposure, rng);
@@ -336,7 +367,8 @@ void synthesize_recording(const SynthSettings& s) {
           calib::write_image_atomically(file("mask"), mask);
         }
         return video;
-      });
+      },
+      [&](int k) { return s.faults.dropped.contains(k); });
   spdlog::info("synth: wrote {} ({} frames, exposure {:.4g}, tracker {} records)", s.out.string(), s.frames, exposure,
                tracker.noisy_samples.size());
 }

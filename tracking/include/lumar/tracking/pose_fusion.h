@@ -9,6 +9,7 @@
 // sigma_t * sqrt(g / (2 - g)) (g = the gain); a video drifting by d per frame adds about
 // d / g. Until 1/g frames have passed the gain is 1/(n + 1), the running mean of the
 // tracker's offset from the video's path, so that the start needs no settling.
+#include <algorithm>
 #include <optional>
 
 #include "lumar/base/pose.h"
@@ -16,27 +17,36 @@
 namespace lumar::tracking {
 
 struct PoseFusionSettings {
-  double tracker_gain = 0.05;  // (0, 1]; 1 = the tracker alone
+  double tracker_gain = 0.035;  // (0, 1]; 1 = the tracker alone
 };
 
 class PoseFusion {
  public:
+  // While the video is lost the tracker's gain grows by this per frame, up to the most.
+  static constexpr double kCoastGainPerFrame = 1.0 / 240, kMaxCoastGain = 0.25;
+
   explicit PoseFusion(const PoseFusionSettings& settings = {});
 
   // One frame. `visual`: the camera's pose as the video continues it from the last fused
-  // pose (nullopt: the video could not tell; the tracker's own motion since its last
-  // sample stands in). `tracker`: the tracker's pose for the same frame (nullopt: none).
+  // pose (nullopt: the video could not tell; its last motion goes on, pulled towards the
+  // tracker ever harder; before any, or after a gap, the tracker's own motion since its
+  // last sample stands in). `tracker`: the tracker's pose for the same frame (nullopt: none).
   // Returns the fused pose; nullopt until the tracker has given one.
   std::optional<Pose> update(const std::optional<Pose>& visual, const std::optional<Pose>& tracker);
 
-  // Forget everything (a seek, a gap in the frames): the next tracker pose starts again.
+  // Forget everything (a seek): the next tracker pose starts again.
   void reset();
+  // Keep the pose but weigh the next tracker poses as at the start (1/2, 1/3, ...): after
+  // a gap in the frames, bridged by the tracker's noisy motion, the fused pose is worth
+  // about one tracker sample.
+  void restart_mean();
   const std::optional<Pose>& pose() const { return fused_; }
 
  private:
   PoseFusionSettings settings_;
   std::optional<Pose> fused_, last_tracker_;
-  int tracker_frames_ = 0;
+  std::optional<Pose> motion_;  // the video's last motion per frame, in the camera's frame
+  int tracker_frames_ = 0, coasted_ = 0;
 };
 
 }  // namespace lumar::tracking

@@ -27,8 +27,11 @@ struct ImageAidedSettings {
   tracking::PoseFusionSettings fusion;
   int max_corners = 300;
   int min_inliers = 30;         // fewer: the video cannot tell
-  double ransac_px = 1.0;       // PnP inlier threshold
+  double ransac_px = 0.5;       // PnP inlier threshold
   double max_disagree_deg = 3;  // the video's turn against the tracker's, beyond which the video is not trusted
+  // Lucas-Kanade's least eigenvalue per window pixel below which a corner is not tracked:
+  // above the sensor noise of a flat wall, whose "corners" would stay where they were put.
+  double min_eigen = 1e-4;
 };
 
 class ImageAidedPose {

@@ -14,6 +14,7 @@
 #include <optional>
 #include <string>
 
+#include "lumar/pipeline/image_aided_pose.h"
 #include "lumar/pipeline/live_inputs.h"
 #include "lumar/pipeline/live_loop.h"
 #include "lumar/pipeline/overlay.h"
@@ -28,8 +29,9 @@ struct LiveOverlayOptions {
   std::optional<std::string> response;  // camera response JSON, or "srgb"
   std::optional<double> vignetting_a, vignetting_b, exposure;
   std::optional<tracking::PoseFilterSettings> filter;
-  double max_wait_ms = 40;  // longest a frame waits for the tracker to cover its time
-  int max_frames = 0;       // 0: until the source ends, Ctrl-C or the sink says stop
+  bool steady_with_video = true;  // the tracker's poses steadied by the video (image_aided_pose.h)
+  double max_wait_ms = 40;        // longest a frame waits for the tracker to cover its time
+  int max_frames = 0;             // 0: until the source ends, Ctrl-C or the sink says stop
   OverlaySettings overlay = [] {
     OverlaySettings s;
     s.window = true;
@@ -55,6 +57,7 @@ class LiveOverlay {
  private:
   std::unique_ptr<Overlay> overlay_;
   std::unique_ptr<LiveLoop> loop_;
+  std::unique_ptr<ImageAidedPose> fused_;
   double fps_ = 30;
 };
 

@@ -13,6 +13,15 @@ struct RegistrationError {
   std::vector<double> px;  // per frame that had a pose (and a true one)
   int frames = 0;          // frames read
   double mean = 0, p95 = 0, worst = 0;
+  // How it moves (NaN where the recording has no such stretch). The offset of a frame is
+  // the mean over the points of (projected with the pose - projected with the truth).
+  // jitter_px: RMS of the offset about its mean over each stretch where the true camera
+  // stands still, leaving out the recording's first second and each stretch's first half
+  // second. lag_ms: over the frames where the camera's true motion moves the objects'
+  // centre across the image faster than 20 px/s, -sum(offset . v) / sum(|v|^2), v that
+  // image velocity: how far behind the poses are. overshoot_px: in the half second after a motion stops, the largest
+  // offset along that motion's last direction.
+  double jitter_px, lag_ms, overshoot_px;
 };
 
 // Every frame of `overlay`'s recording with poses from `source`; the overlay's own source

@@ -44,7 +44,8 @@ class ReplayOverlay {
   // frame starts the fusion again from the tracker.
   std::optional<Pose> camera_pose(const capture::Frame& frame);
   PoseSource pose_source() const { return pose_source_; }
-  // Truth: InputError when the recording has none.
+  // Truth: InputError when the recording has none. Fused without a proxy room in the
+  // scene: the tracker's, with a warning.
   void set_pose_source(PoseSource source);
 
   // Decodes the tracker stream again through this filter (nullopt: none). Frame sources

@@ -16,6 +16,7 @@
 #include "lumar/capture/recording_writer.h"
 #include "lumar/capture/session.h"
 #include "lumar/sim/light_change.h"
+#include "lumar/sim/video_faults.h"
 #include "lumar/tracking/simulated_tracker.h"
 
 namespace lumar::sim {
@@ -35,7 +36,7 @@ struct SynthSettings {
   double position_noise_m = 0.0025;  // RMS per axis
   double latency_ms = 20.0;          // device latency
   double arc_deg = 60.0;             // how far the camera orbits
-  std::string path = "orbit";        // orbit | still (held where the orbit ends)
+  std::string path = "orbit";        // orbit | still | room | rest-turn (synth_camera_pose)
   std::string codec = "mjpeg";
   int quality = 95;
   std::uint64_t seed = 1;
@@ -46,6 +47,11 @@ struct SynthSettings {
   int truth_ratio_stride = 4;    // TruthSettings::ratio_stride, in rendered (supersampled) pixels
   // The room's light changes during the recording (light_change.h); not with truth.
   std::optional<LightChange> light_change;
+  // The video shows a room that differs from the scene's proxy (furnished_room.h), which
+  // the session still names: an honest test of anything that aligns video with the proxy.
+  bool room_differs = false;
+  // Dropped frames, a textureless view, an occluder, motion blur (video_faults.h).
+  VideoFaults faults;
 };
 
 // The session's record of the settings every synthetic recording shares ("synth").
@@ -75,16 +81,22 @@ using SyntheticFrameRenderer = std::function<cv::Mat(int k, Nanos t, const Pose&
 // simulated tracker's stream, and `frames` frames at `frame_time(k)` seen from
 // `true_camera(t)`, drawn by `render` with one noise generator seeded by `seed`. On any
 // failure the partial directory is removed and the error rethrown.
+// `dropped(k)`: frame k is left out of the video (not rendered, its index skipped).
 void write_synthetic_recording(const std::filesystem::path& out, const capture::Session& session,
                                const tracking::SimulatedTrackerOutput& tracker, const capture::RecordingSettings& video,
                                int frames, std::uint64_t seed, const std::function<Nanos(int)>& frame_time,
-                               const std::function<Pose(Nanos)>& true_camera, const SyntheticFrameRenderer& render);
+                               const std::function<Pose(Nanos)>& true_camera, const SyntheticFrameRenderer& render,
+                               const std::function<bool(int)>& dropped = {});
 
 // The camera's true pose at s in [0, 1] along the orbit around `target`.
 Pose orbit_camera_pose(const glm::dvec3& target, double s, double arc_deg);
-// The camera's true pose at s in [0, 1] along the named path ("orbit", "still");
-// InputError for another name.
-Pose synth_camera_pose(const std::string& path, const glm::dvec3& target, double s, double arc_deg);
+// The camera's true pose along the named path at s in [0, 1] of the recording, t_s
+// seconds into it: "orbit"; "still" (held where the orbit ends); "room" (standing back,
+// turning slowly); "rest-turn" (held halfway along the orbit for 2 s, then turning about
+// the vertical at 30 degrees/s for 1 s, then held). InputError for another name.
+Pose synth_camera_pose(const std::string& path, const glm::dvec3& target, double s, double t_s, double arc_deg);
+// rest-turn: when the turn starts and ends, seconds, and its rate, degrees per second.
+constexpr double kRestTurnStartS = 2.0, kRestTurnEndS = 3.0, kRestTurnDegPerS = 30.0;
 
 // The sample room's two light changes (data/scenes/room; the tests and
 // bench_lighting_change): "lamp-off", the ceiling lamp at (-1.2, 3, 0.3) going out at
