@@ -29,7 +29,8 @@ struct OverlayOptions {
   std::string save_scene, screenshot, stats_json;
   int max_frames = 0;
   int adapt_lighting = 0, adapt_lighting_cells = 32;
-  pipeline::LiveOverlayOptions live;  // --source and what only the live path reads
+  pipeline::ImageAidedSettings image_aided;  // --poses fused
+  pipeline::LiveOverlayOptions live;         // --source and what only the live path reads
 };
 
 pipeline::OverlaySettings overlay_settings(const OverlayOptions& o, bool window) {
@@ -96,6 +97,7 @@ void run_live(OverlayOptions& o) {
   if (!o.contact_sheet.empty()) throw InputError("--contact-sheet: a live run has no known length; use --frames-dir");
   if (o.poses == "truth") throw InputError("--poses truth: a live source has no ground truth");
   o.live.steady_with_video = o.poses == "fused";
+  o.live.image_aided = o.image_aided;
   pipeline::LiveOverlayOptions& live = o.live;
   live.scene = o.scene;
   live.max_frames = o.max_frames;
@@ -135,6 +137,7 @@ void run_replay(const OverlayOptions& o) {
                    : o.poses == "fused" ? pipeline::PoseSource::Fused
                                         : pipeline::PoseSource::Tracker;
   settings.filter = tracking::parse_pose_filter(o.filter);
+  settings.image_aided = o.image_aided;
   settings.allow_incomplete = o.allow_incomplete;
   settings.overlay = overlay_settings(o, o.window);
   if (o.window) settings.overlay.window_panel_width = ui::kPanelWidth;
@@ -197,6 +200,10 @@ void register_overlay(CLI::App& app) {
                   "alone, or the recording's "
                   "ground truth")
       ->check(CLI::IsMember({"tracker", "fused", "truth"}))
+      ->capture_default_str();
+  cmd->add_option("--tracker-gain", o->image_aided.fusion.tracker_gain,
+                  "--poses fused: how much each frame's fused pose moves towards the tracker's, in (0, 1] (lower: "
+                  "steadier, slower to leave the video's drift; docs/tracker.md)")
       ->capture_default_str();
   cmd->add_option("--filter", o->filter,
                   "Pose filter on the tracker's samples: none, one-euro (the setting the filter benchmark chose: "

@@ -154,6 +154,13 @@ case_overlay_pose_sources() {
     fail "the video's help changed nothing"
   expect_bad_input "--poses truth" "" -- "$LUMAR" overlay --source "recording:$REC" --poses truth --scene \
     "$SRC/data/scenes/room/scene.json"
+  expect_bad_input "--tracker-gain" "$TMP/bad" -- "$LUMAR" overlay --recording "$REC" --tracker-gain 0 \
+    --frames-dir "$TMP/bad"
+  # The knob reaches the fusion: the tracker alone (gain 1) gives the tracker's frames.
+  "$LUMAR" overlay --recording "$REC" --tracker-gain 1 --max-frames 6 --frames-dir "$TMP/gain1" >"$TMP/log" 2>&1 ||
+    { cat "$TMP/log"; fail "--tracker-gain 1 failed"; }
+  ! cmp -s "$TMP/gain1/$(ls "$TMP/gain1" | tail -1)" "$TMP/fused/$(ls "$TMP/fused" | tail -1)" ||
+    fail "--tracker-gain changed nothing"
 }
 
 # A copy of the sample recording at the same depth, so its relative scene path still resolves.

@@ -1,6 +1,7 @@
 #include "lumar/tracking/pose_fusion.h"
 
 #include <algorithm>
+#include <string>
 
 #include "lumar/base/error.h"
 
@@ -8,7 +9,8 @@ namespace lumar::tracking {
 
 PoseFusion::PoseFusion(const PoseFusionSettings& settings) : settings_(settings) {
   if (!(settings.tracker_gain > 0.0 && settings.tracker_gain <= 1.0))
-    throw InputError("pose fusion: the tracker's gain must be in (0, 1]");
+    throw InputError("--tracker-gain: the fused pose's pull towards the tracker must be in (0, 1], not " +
+                     std::to_string(settings.tracker_gain));
 }
 
 void PoseFusion::restart_mean() {
@@ -43,7 +45,7 @@ std::optional<Pose> PoseFusion::update(const std::optional<Pose>& visual, const 
     // The longer the video has been lost, the more the tracker is trusted, so that the
     // fused pose slides back to it rather than jumping.
     const double coasting = std::min(kMaxCoastGain, settings_.tracker_gain + coasted_ * kCoastGainPerFrame);
-    const double gain = std::max(coasting, 1.0 / (tracker_frames_ + 1));
+    const double gain = std::max({settings_.tracker_gain, coasting, 1.0 / (tracker_frames_ + 1)});
     predicted = interpolate(predicted, *tracker, gain);
     ++tracker_frames_;
     last_tracker_ = tracker;

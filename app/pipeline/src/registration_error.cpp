@@ -1,6 +1,7 @@
 #include "lumar/pipeline/registration_error.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <limits>
 #include <optional>
@@ -38,7 +39,9 @@ RegistrationError registration_error(ReplayOverlay& overlay, PoseSource source) 
   while (frames->read(frame)) {
     ++out.frames;
     overlay.overlay().play_paths(frame.time);
+    const auto t0 = std::chrono::steady_clock::now();
     const auto pose = overlay.camera_pose(frame);
+    out.pose_ms += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     const auto truth = overlay.replay().true_camera_pose(frame.index);
     if (!pose || !truth) continue;
     out.px.push_back(projection_error_px(camera, points, *pose, *truth));
@@ -54,6 +57,7 @@ RegistrationError registration_error(ReplayOverlay& overlay, PoseSource source) 
     last_truth = truth;
   }
   overlay.set_pose_source(was);
+  if (out.frames > 0) out.pose_ms /= out.frames;
 
   const double nan = std::numeric_limits<double>::quiet_NaN();
   out.jitter_px = out.lag_ms = out.overshoot_px = nan;

@@ -15,7 +15,10 @@ double ms_since(std::chrono::steady_clock::time_point t0) {
 }  // namespace
 
 ReplayOverlay::ReplayOverlay(const std::filesystem::path& recording, const ReplayOverlaySettings& settings)
-    : recording_(recording), replay_(recording, settings.filter), pose_source_(settings.poses) {
+    : recording_(recording),
+      replay_(recording, settings.filter),
+      pose_source_(settings.poses),
+      image_aided_(settings.image_aided) {
   if (!replay_.reader().complete() && !settings.allow_incomplete)
     throw InputError(recording.string() + ": incomplete recording (\"complete\": false; its writer was killed, " +
                      "crashed or ran out of disk); its " + std::to_string(replay_.reader().frames().size()) +
@@ -47,7 +50,8 @@ void ReplayOverlay::set_pose_source(PoseSource source) {
   }
   pose_source_ = source;
   fused_.reset();
-  if (source == PoseSource::Fused) fused_ = std::make_unique<ImageAidedPose>(replay_.session().camera, scene().room);
+  if (source == PoseSource::Fused)
+    fused_ = std::make_unique<ImageAidedPose>(replay_.session().camera, scene().room, image_aided_);
 }
 
 std::optional<Pose> ReplayOverlay::camera_pose(const capture::Frame& frame) {

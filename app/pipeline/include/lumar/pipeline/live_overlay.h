@@ -30,8 +30,9 @@ struct LiveOverlayOptions {
   std::optional<double> vignetting_a, vignetting_b, exposure;
   std::optional<tracking::PoseFilterSettings> filter;
   bool steady_with_video = true;  // the tracker's poses steadied by the video (image_aided_pose.h)
-  double max_wait_ms = 40;        // longest a frame waits for the tracker to cover its time
-  int max_frames = 0;             // 0: until the source ends, Ctrl-C or the sink says stop
+  ImageAidedSettings image_aided;
+  double max_wait_ms = 40;  // longest a frame waits for the tracker to cover its time
+  int max_frames = 0;       // 0: until the source ends, Ctrl-C or the sink says stop
   OverlaySettings overlay = [] {
     OverlaySettings s;
     s.window = true;

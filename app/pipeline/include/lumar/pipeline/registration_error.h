@@ -13,6 +13,7 @@ struct RegistrationError {
   std::vector<double> px;  // per frame that had a pose (and a true one)
   int frames = 0;          // frames read
   double mean = 0, p95 = 0, worst = 0;
+  double pose_ms = 0;  // the pose source's time per frame (decoding not counted)
   // How it moves (NaN where the recording has no such stretch). The offset of a frame is
   // the mean over the points of (projected with the pose - projected with the truth).
   // jitter_px: RMS of the offset about its mean over each stretch where the true camera

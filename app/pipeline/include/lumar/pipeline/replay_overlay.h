@@ -24,6 +24,7 @@ struct ReplayOverlaySettings {
   std::filesystem::path scene;  // empty: the one the recording's session names
   PoseSource poses = PoseSource::Tracker;
   std::optional<tracking::PoseFilterSettings> filter;  // on the tracker's samples (not on the truth)
+  ImageAidedSettings image_aided;                      // for PoseSource::Fused
   OverlaySettings overlay;
   // Replay a recording whose writer never closed it (killed, crashed, disk full): its
   // closed segments are whole, but it may end early. Refused by default.
@@ -66,6 +67,7 @@ class ReplayOverlay {
   capture::RecordingReplay replay_;
   PoseSource pose_source_;
   std::unique_ptr<Overlay> overlay_;
+  ImageAidedSettings image_aided_;
   std::unique_ptr<ImageAidedPose> fused_;  // while the source is Fused
 };
 
