@@ -43,37 +43,30 @@ int main(int argc, char** argv) {
 
   std::map<int, double> errors, settled;
   for (int cols : kColumns)
-    benchmark::RegisterBenchmark(fmt::format("cells/{}", cols).c_str(),
-                                 [&, cols](benchmark::State& state) {
-                                   for (auto _ : state) {
-                                     double error = 0, ms = 0, settle = 0;
-                                     for (std::size_t k = 0; k < recordings.size(); ++k) {
-                                       pipeline::ReplayOverlaySettings rs;
-                                       rs.poses = pipeline::PoseSource::Truth;
-                                       rs.overlay.features = {false, false, false, false, false};
-                                       rs.overlay.adapt_lighting_every = 2;
-                                       rs.overlay.adapt_lighting_cells = cols;
-                                       rs.overlay.volume_cache = false;
-                                       const auto f = pipeline::follow_lighting_change(
-                                           recordings[k].out, changed[k], recordings[k].light_change->at_s, rs);
-                                       error += f.end_err / double(recordings.size());
-                                       ms += f.adaptation_ms_per_frame / double(recordings.size());
-                                       settle = std::max(settle, f.settled_after_s < 0 ? 99.0 : f.settled_after_s);
-                                     }
-                                     state.SetIterationTime(ms * 1e-3);
-                                     errors[cols] = error;
-                                     settled[cols] = settle;
-                                     state.counters["error_pct"] = 100 * error;
-                                     state.counters["settled_s"] = settle;
-                                   }
-                                 })
-        ->UseManualTime()
-        ->Iterations(1)
-        ->Unit(benchmark::kMillisecond);
+    bench::register_measured_once(fmt::format("cells/{}", cols), [&, cols](benchmark::State& state) {
+      double error = 0, ms = 0, settle = 0;
+      for (std::size_t k = 0; k < recordings.size(); ++k) {
+        pipeline::ReplayOverlaySettings rs;
+        rs.poses = pipeline::PoseSource::Truth;
+        rs.overlay.features = {false, false, false, false, false};
+        rs.overlay.adapt_lighting_every = 2;
+        rs.overlay.adapt_lighting_cells = cols;
+        rs.overlay.volume_cache = false;
+        const auto f =
+            pipeline::follow_lighting_change(recordings[k].out, changed[k], recordings[k].light_change->at_s, rs);
+        error += f.end_err / double(recordings.size());
+        ms += f.adaptation_ms_per_frame / double(recordings.size());
+        settle = std::max(settle, f.settled_after_s < 0 ? 99.0 : f.settled_after_s);
+      }
+      errors[cols] = error;
+      settled[cols] = settle;
+      state.counters["error_pct"] = 100 * error;
+      state.counters["settled_s"] = settle;
+      return ms;
+    });
 
-  benchmark::Initialize(&argc, argv);
   bench::CollectingReporter reporter;
-  benchmark::RunSpecifiedBenchmarks(&reporter);
+  bench::run_benchmarks(argc, argv, reporter);
   std::filesystem::remove_all(dir);
 
   bench::BenchReport report;

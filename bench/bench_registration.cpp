@@ -60,35 +60,27 @@ int main(int argc, char** argv) {
 
   std::map<std::string, Measured> measured;
   for (const Setting& setting : kSettings)
-    benchmark::RegisterBenchmark(
-        setting.name.c_str(),
-        [&, setting](benchmark::State& state) {
-          for (auto _ : state) {
-            pipeline::ReplayOverlaySettings rs;
-            rs.image_aided.fusion.tracker_gain = setting.gain;
-            rs.image_aided.max_corners = setting.corners;
-            Measured m;
-            for (const auto* r : {&turn, &differs}) {
-              pipeline::ReplayOverlay overlay(r->out, rs);
-              const auto e = pipeline::registration_error(overlay, pipeline::PoseSource::Fused);
-              m.mean_px += e.mean / 2, m.ms += e.pose_ms / 2;
-              if (r == &turn) m.jitter_px = e.jitter_px, m.lag_ms = e.lag_ms, m.overshoot_px = e.overshoot_px;
-            }
-            state.SetIterationTime(m.ms * 1e-3);
-            state.counters["mean_px"] = m.mean_px;
-            state.counters["jitter_px"] = m.jitter_px;
-            state.counters["lag_ms"] = m.lag_ms;
-            state.counters["overshoot_px"] = m.overshoot_px;
-            measured[setting.name] = m;
-          }
-        })
-        ->UseManualTime()
-        ->Iterations(1)
-        ->Unit(benchmark::kMillisecond);
+    bench::register_measured_once(setting.name, [&, setting](benchmark::State& state) {
+      pipeline::ReplayOverlaySettings rs;
+      rs.image_aided.fusion.tracker_gain = setting.gain;
+      rs.image_aided.max_corners = setting.corners;
+      Measured m;
+      for (const auto* r : {&turn, &differs}) {
+        pipeline::ReplayOverlay overlay(r->out, rs);
+        const auto e = pipeline::registration_error(overlay, pipeline::PoseSource::Fused);
+        m.mean_px += e.mean / 2, m.ms += e.pose_ms / 2;
+        if (r == &turn) m.jitter_px = e.jitter_px, m.lag_ms = e.lag_ms, m.overshoot_px = e.overshoot_px;
+      }
+      state.counters["mean_px"] = m.mean_px;
+      state.counters["jitter_px"] = m.jitter_px;
+      state.counters["lag_ms"] = m.lag_ms;
+      state.counters["overshoot_px"] = m.overshoot_px;
+      measured[setting.name] = m;
+      return m.ms;
+    });
 
-  benchmark::Initialize(&argc, argv);
   bench::CollectingReporter reporter;
-  benchmark::RunSpecifiedBenchmarks(&reporter);
+  bench::run_benchmarks(argc, argv, reporter);
   std::filesystem::remove_all(dir);
 
   bench::BenchReport report;

@@ -208,4 +208,19 @@ void CollectingReporter::ReportRuns(const std::vector<Run>& runs) {
   }
 }
 
+void register_measured_once(const std::string& name, const std::function<double(benchmark::State&)>& measure) {
+  benchmark::RegisterBenchmark(name.c_str(),
+                               [measure](benchmark::State& state) {
+                                 for (auto _ : state) state.SetIterationTime(measure(state) * 1e-3);
+                               })
+      ->UseManualTime()
+      ->Iterations(1)
+      ->Unit(benchmark::kMillisecond);
+}
+
+void run_benchmarks(int& argc, char** argv, CollectingReporter& reporter) {
+  benchmark::Initialize(&argc, argv);
+  benchmark::RunSpecifiedBenchmarks(&reporter);
+}
+
 }  // namespace lumar::bench

@@ -51,6 +51,8 @@ std::filesystem::path results_dir();
 }  // namespace lumar::bench
 
 #include <benchmark/benchmark.h>
+
+#include <functional>
 #include <map>
 
 namespace lumar::bench {
@@ -72,5 +74,14 @@ class CollectingReporter : public benchmark::ConsoleReporter {
  private:
   std::map<std::string, Result> results_;
 };
+
+// A benchmark that runs its measurement once and reports the time the measurement gives
+// (ms per operation) rather than the wall time of the run: for costs measured inside a
+// larger replay. `measure` may set counters on the state.
+void register_measured_once(const std::string& name, const std::function<double(benchmark::State&)>& measure);
+
+// Runs the registered benchmarks (the command line's --benchmark_filter applies) and keeps
+// their results.
+void run_benchmarks(int& argc, char** argv, CollectingReporter& reporter);
 
 }  // namespace lumar::bench
