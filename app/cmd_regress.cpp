@@ -14,6 +14,7 @@
 #include "lumar/base/error.h"
 #include "lumar/base/json_file.h"
 #include "lumar/base/output_file.h"
+#include "lumar/calib/board_pose.h"
 #include "lumar/calib/camera_response.h"
 #include "lumar/calib/image_file.h"
 #include "lumar/calib/undistortion.h"
@@ -57,13 +58,8 @@ double render_vs_opencv_px(Compositor& compositor, const Pose& T_world_camera, s
     }
   *covered = world.size();
   if (world.empty()) return 0.0;
-  const Pose T_camera_world = T_world_camera.inverse();
-  const glm::dmat3 R = T_camera_world.rotation_matrix();
-  cv::Matx33d Rcv;
-  for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 3; ++j) Rcv(i, j) = R[j][i];
-  cv::Vec3d rvec, tvec(T_camera_world.translation.x, T_camera_world.translation.y, T_camera_world.translation.z);
-  cv::Rodrigues(Rcv, rvec);
+  cv::Vec3d rvec, tvec;
+  calib::pose_to_rvec_tvec(T_world_camera.inverse(), rvec, tvec);
   std::vector<cv::Point2d> projected;
   cv::projectPoints(world, rvec, tvec, cv::Mat(compositor.output_camera().camera_matrix()), cv::Mat(), projected);
   double sum = 0;

@@ -6,6 +6,7 @@
 #include <opencv2/video/tracking.hpp>
 
 #include "lumar/base/error.h"
+#include "lumar/calib/board_pose.h"
 
 namespace lumar::pipeline {
 
@@ -19,27 +20,6 @@ std::vector<cv::Point2f> normalised(const CameraIntrinsics& camera, const std::v
   if (!pixels.empty())
     cv::undistortPoints(pixels, out, cv::Mat(camera.camera_matrix()), camera.distortion_coefficients());
   return out;
-}
-
-Pose pose_from_opencv(const cv::Vec3d& rvec, const cv::Vec3d& tvec) {
-  cv::Matx33d R;
-  cv::Rodrigues(rvec, R);
-  glm::dmat4 m(1.0);
-  for (int r = 0; r < 3; ++r) {
-    for (int c = 0; c < 3; ++c) m[c][r] = R(r, c);
-    m[3][r] = tvec[r];
-  }
-  return Pose::from_matrix(m).inverse();  // OpenCV's is T_camera_world
-}
-
-void pose_to_opencv(const Pose& T_world_camera, cv::Vec3d& rvec, cv::Vec3d& tvec) {
-  const Pose T = T_world_camera.inverse();
-  const glm::dmat3 M = T.rotation_matrix();
-  cv::Matx33d R;
-  for (int r = 0; r < 3; ++r)
-    for (int c = 0; c < 3; ++c) R(r, c) = M[c][r];
-  cv::Rodrigues(R, rvec);
-  tvec = cv::Vec3d(T.translation.x, T.translation.y, T.translation.z);
 }
 
 }  // namespace
@@ -87,7 +67,7 @@ std::optional<Pose> ImageAidedPose::pose_from_video(const cv::Mat& grey, const P
   Pose guess = last;
   if (tracker && last_tracker_) guess = last * (last_tracker_->inverse() * *tracker);
   cv::Vec3d rvec, tvec;
-  pose_to_opencv(guess, rvec, tvec);
+  calib::pose_to_rvec_tvec(guess.inverse(), rvec, tvec);  // OpenCV's pose is T_camera_world
   std::vector<cv::Point2f> ahead, back;
   cv::projectPoints(points_, rvec, tvec, cv::Mat(camera_.camera_matrix()), camera_.distortion_coefficients(), ahead);
   std::vector<std::uint8_t> ok_ahead, ok_back;
@@ -120,9 +100,9 @@ std::optional<Pose> ImageAidedPose::pose_from_video(const cv::Mat& grey, const P
   std::vector<cv::Point3f> in_points;
   std::vector<cv::Point2f> in_seen;
   for (int i : inliers) in_points.push_back(points[i]), in_seen.push_back(seen[i]);
-  pose_to_opencv(guess, rvec, tvec);
+  calib::pose_to_rvec_tvec(guess.inverse(), rvec, tvec);
   cv::solvePnPRefineLM(in_points, normalised(camera_, in_seen), cv::Matx33d::eye(), cv::noArray(), rvec, tvec);
-  const Pose pose = pose_from_opencv(rvec, tvec);
+  const Pose pose = calib::pose_from_rvec_tvec(rvec, tvec).inverse();
   if (!pose.is_finite() || rotation_angle_deg(pose.rotation, guess.rotation) > settings_.max_disagree_deg)
     return std::nullopt;
   for (int i : inliers) tracked_.push_back(seen[i]);

@@ -6,9 +6,9 @@
 // room's planes make the essential matrix degenerate; the proxy's depth does not). That
 // pose, continuing the last fused one, is fused with the tracker's by
 // tracking::PoseFusion. Where the video cannot tell (too few corners or inliers, a jump
-// the tracker does not share), the tracker's own motion stands in, so the fused pose
-// falls back to the tracker's without a jump (also over dropped frames, up to a second
-// of them). Frames must come in order; a seek starts again from the tracker.
+// the tracker does not share), its last motion goes on while the fused pose slides back
+// to the tracker's, without a jump; over dropped frames (up to 30) the tracker's motion
+// bridges the gap. Frames must come in order; a seek starts again from the tracker.
 #include <cstdint>
 #include <opencv2/core.hpp>
 #include <optional>
