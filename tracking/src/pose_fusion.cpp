@@ -22,7 +22,7 @@ void PoseFusion::reset() {
   fused_.reset();
   motion_.reset();
   last_tracker_.reset();
-  tracker_frames_ = 0;
+  tracker_frames_ = coasted_ = 0;
 }
 
 std::optional<Pose> PoseFusion::update(const std::optional<Pose>& visual, const std::optional<Pose>& tracker) {
