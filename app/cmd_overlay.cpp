@@ -205,6 +205,13 @@ void register_overlay(CLI::App& app) {
                   "--poses fused: how much each frame's fused pose moves towards the tracker's, in (0, 1] (lower: "
                   "steadier, slower to leave the video's drift; docs/tracker.md)")
       ->capture_default_str();
+  cmd->add_option("--align-every", o->image_aided.align_every,
+                  "--poses fused: frames between absolute fixes, each the frame aligned with the room the proxy "
+                  "and the map predict (0: only at the start and after a gap)")
+      ->capture_default_str();
+  cmd->add_option("--fix-worth", o->image_aided.fusion.fix_worth,
+                  "--poses fused: how many tracker samples one absolute fix is worth (0: no fixes)")
+      ->capture_default_str();
   cmd->add_option("--filter", o->filter,
                   "Pose filter on the tracker's samples: none, one-euro (the setting the filter benchmark chose: "
                   "docs/tracker_filter_jitter_vs_lag.png) or one-euro:MIN_CUTOFF_HZ,BETA")

@@ -182,7 +182,7 @@ void BenchReport::save(const std::filesystem::path& dir) const {
 }
 
 std::filesystem::path results_dir() {
-  if (const char* env = std::getenv("LUMAR_BENCH_OUT")) return env;
+  if (const char* env = std::getenv("LUMAR_BENCH_OUT"); env && *env) return env;
   return std::filesystem::path(LUMAR_SOURCE_DIR) / "bench" / "results";
 }
 

@@ -137,8 +137,9 @@ PY
 }
 
 case_overlay_pose_sources() {
-  # fused (the default), tracker and truth give the same first frame (the fused pose
-  # starts as the tracker's) and then differ; a live source has no truth.
+  # fused (the default), tracker and truth differ from the first frame on (the fused pose
+  # starts from the frame aligned with the proxy's room); without fixes (--fix-worth 0)
+  # the fused pose starts as the tracker's. A live source has no truth.
   local p
   for p in fused tracker truth; do
     "$LUMAR" overlay --recording "$REC" --poses $p --max-frames 6 --frames-dir "$TMP/$p" >"$TMP/log" 2>&1 ||
@@ -148,13 +149,21 @@ case_overlay_pose_sources() {
   "$LUMAR" overlay --recording "$REC" --max-frames 6 --frames-dir "$TMP/default" >"$TMP/log" 2>&1 || fail "default"
   cmp -s "$TMP/default/$(ls "$TMP/default" | tail -1)" "$TMP/fused/$(ls "$TMP/fused" | tail -1)" ||
     fail "the default is not --poses fused"
-  cmp -s "$TMP/fused/$(ls "$TMP/fused" | head -1)" "$TMP/tracker/$(ls "$TMP/tracker" | head -1)" ||
-    fail "the first fused frame is not the tracker's"
-  ! cmp -s "$TMP/fused/$(ls "$TMP/fused" | tail -1)" "$TMP/tracker/$(ls "$TMP/tracker" | tail -1)" ||
+  ! cmp -s "$TMP/fused/$(ls "$TMP/fused" | head -1)" "$TMP/tracker/$(ls "$TMP/tracker" | head -1)" ||
+    fail "the first fused frame is the tracker's: no absolute fix"
+  "$LUMAR" overlay --recording "$REC" --fix-worth 0 --max-frames 6 --frames-dir "$TMP/nofix" >"$TMP/log" 2>&1 ||
+    { cat "$TMP/log"; fail "--fix-worth 0 failed"; }
+  cmp -s "$TMP/nofix/$(ls "$TMP/nofix" | head -1)" "$TMP/tracker/$(ls "$TMP/tracker" | head -1)" ||
+    fail "without fixes the first fused frame is not the tracker's"
+  ! cmp -s "$TMP/nofix/$(ls "$TMP/nofix" | tail -1)" "$TMP/tracker/$(ls "$TMP/tracker" | tail -1)" ||
     fail "the video's help changed nothing"
   expect_bad_input "--poses truth" "" -- "$LUMAR" overlay --source "recording:$REC" --poses truth --scene \
     "$SRC/data/scenes/room/scene.json"
   expect_bad_input "--tracker-gain" "$TMP/bad" -- "$LUMAR" overlay --recording "$REC" --tracker-gain 0 \
+    --frames-dir "$TMP/bad"
+  expect_bad_input "--align-every" "$TMP/bad" -- "$LUMAR" overlay --recording "$REC" --align-every -1 \
+    --frames-dir "$TMP/bad"
+  expect_bad_input "--fix-worth" "$TMP/bad" -- "$LUMAR" overlay --recording "$REC" --fix-worth -2 \
     --frames-dir "$TMP/bad"
   # The knob reaches the fusion: the tracker alone (gain 1) gives the tracker's frames.
   "$LUMAR" overlay --recording "$REC" --tracker-gain 1 --max-frames 6 --frames-dir "$TMP/gain1" >"$TMP/log" 2>&1 ||

@@ -1,6 +1,7 @@
-// Image-aided tracking on synthetic recordings, against their true poses: the shipped
+// Image-aided tracking on synthetic recordings, against their true poses, with absolute
+// fixes from the frame aligned with the room the proxy predicts (the default): the shipped
 // orbit and walk, and more made here: a room unlike the proxy the overlay is given (a low
-// table, a box, a cabinet, a wall 3 cm off), a rest-then-turn (held 2 s, 30 deg/s for 1 s,
+// table, a box, a cabinet, a wall 3 cm off with a recess), a rest-then-turn (held 2 s, 30 deg/s for 1 s,
 // held), and what goes wrong with video: ten dropped frames, a textureless view, a panel
 // sliding across half the view, motion blur. The tracker has 0.75 deg / 2.5 mm noise and 20 ms
 // latency in all of them. Registration is measured as `lumar regress` measures it
@@ -38,8 +39,8 @@ struct Both {
   int worse = 0;  // frames where the fused pose is worse than the tracker's by over 1 px
 };
 
-Both measure(const std::filesystem::path& recording) {
-  pipeline::ReplayOverlay overlay(recording);
+Both measure(const std::filesystem::path& recording, const pipeline::ReplayOverlaySettings& settings = {}) {
+  pipeline::ReplayOverlay overlay(recording, settings);
   Both b{pipeline::registration_error(overlay, pipeline::PoseSource::Tracker),
          pipeline::registration_error(overlay, pipeline::PoseSource::Fused)};
   std::string which;
@@ -89,25 +90,39 @@ TEST(ImageAidedPose, TheVideoAloneFollowsTheCameraFromItsFirstPose) {
   EXPECT_LT(last, 1.0);
 }
 
-// The shipped recordings: the tracker's 4.6-5.1 px to about 1 px, the mean of the tracker's
-// first samples being all there is at the start (the first frame is the tracker's).
+// The shipped recordings: the tracker's 4.6-5.1 px mean (9 px p95) to a fraction of a
+// pixel, from the first frame on: it is aligned with the room the proxy predicts.
 TEST(ImageAidedPose, SteadiesTheTrackerOnTheSampleRecordings) {
   for (const char* name : {"orbit", "walk"}) {
     const Both b = measure(test::source_dir() / "recordings" / name);
-    EXPECT_LT(b.fused.mean, 1.1) << name;
-    EXPECT_LT(b.fused.mean, 0.25 * b.tracker.mean) << name;
-    EXPECT_NEAR(b.fused.px[0], b.tracker.px[0], 1e-9) << "the first frame is the tracker's";
-    EXPECT_LE(b.worse, 2) << name;
+    EXPECT_LT(b.fused.mean, 0.5) << name;  // the issue: <= 1.0
+    EXPECT_LT(b.fused.p95, 1.0) << name;   // the issue: <= 2.5
+    EXPECT_LT(b.fused.px[0], 0.5) << name << ": the first frame's fix";
+    EXPECT_EQ(b.worse, 0) << name;
   }
 }
 
+// Without absolute fixes the fused pose starts as the tracker's and becomes the running
+// mean of its offsets from the video's path, so the first frames are as bad as a few
+// tracker samples: the fixes are what bring the p95 down.
+TEST(ImageAidedPose, WithoutFixesTheStartIsTheTrackersMean) {
+  pipeline::ReplayOverlaySettings settings;
+  settings.image_aided.fusion.fix_worth = 0;
+  const Both b = measure(test::source_dir() / "recordings/orbit", settings);
+  EXPECT_NEAR(b.fused.px[0], b.tracker.px[0], 1e-9) << "the first frame is the tracker's";
+  EXPECT_LT(b.fused.mean, 1.1);
+  EXPECT_GT(b.fused.p95, 2.5);
+}
+
 // The video shows a low table, a box and a cabinet the proxy does not have, and a wall 3 cm
-// further back: the corners on them get the wrong depth, and RANSAC must leave them out.
+// further back with a recess in it: the corners on them get the wrong depth, and the
+// fixes' matches on them are wrong; RANSAC must leave them out. The issue's targets for
+// the sample (mean <= 1 px, p95 <= 2.5 px) hold here too.
 TEST(ImageAidedPose, HoldsInARoomUnlikeTheProxy) {
   const Both b = measure(synthesize("room-differs", [](sim::SynthSettings& s) { s.room_differs = true; }));
-  EXPECT_LT(b.fused.mean, 1.2);
-  EXPECT_LT(b.fused.mean, 0.3 * b.tracker.mean);
-  EXPECT_LE(b.worse, 2);
+  EXPECT_LT(b.fused.mean, 0.6);
+  EXPECT_LT(b.fused.p95, 1.0);
+  EXPECT_EQ(b.worse, 0);
 }
 
 // Held 2 s, turned at 30 deg/s for 1 s, held: the issue's jitter, lag and overshoot.
@@ -121,25 +136,23 @@ TEST(ImageAidedPose, RestThenTurnNeitherJittersNorLagsNorOvershoots) {
   EXPECT_LT(std::abs(b.fused.lag_ms), 5.0);
   EXPECT_LT(b.fused.overshoot_px, 1.0);
   EXPECT_GT(b.tracker.jitter_px, 3.0);  // what it steadies
-  EXPECT_LT(b.fused.mean, 1.0);
+  EXPECT_LT(b.fused.mean, 0.5);
+  EXPECT_EQ(b.worse, 0);
 }
 
 // Ten frames missing: the video cannot bridge 12.8 degrees of turn on the rug's stripes,
-// the tracker's motion does, and the fused pose then trusts the tracker as at the start.
+// the tracker's motion does, and the frame after the gap is aligned with the proxy's room.
 TEST(ImageAidedPose, BridgesTenDroppedFrames) {
   const auto recording = synthesize("dropped", [](sim::SynthSettings& s) { s.faults.dropped = {20, 10}; });
   ASSERT_EQ(capture::RecordingReplay(recording).reader().frames().size(), 38u);
   const Both b = measure(recording);
-  EXPECT_LT(b.fused.mean, 1.6);
-  EXPECT_LT(b.fused.mean, 0.4 * b.tracker.mean);
-  EXPECT_LE(b.worse, 3);
+  EXPECT_LT(b.fused.mean, 0.5);
+  EXPECT_EQ(b.worse, 0);
 }
 
 // The video cannot tell for half a second (a flat wall), or half of it moves on its own (a
 // panel walking through), or every frame is smeared by a full frame period of motion
-// (about 1.3 degrees, 12 px): no frame is worse than the tracker's by over 1 px except at
-// the start, where the mean of a few tracker samples can lose to a lucky one (frames 3
-// and 7 here, the same in every recording of this path and seed).
+// (about 1.3 degrees, 12 px): no frame is worse than the tracker's by over 1 px.
 TEST(ImageAidedPose, DegradesGracefully) {
   const std::vector<std::pair<std::string, std::function<void(sim::SynthSettings&)>>> cases{
       {"textureless",
@@ -153,10 +166,8 @@ TEST(ImageAidedPose, DegradesGracefully) {
       {"motion-blur", [](sim::SynthSettings& s) { s.faults.motion_blur_s = 1.0 / 24; }}};
   for (const auto& [name, change] : cases) {
     const Both b = measure(synthesize(name, change));
-    EXPECT_LT(b.fused.mean, 0.35 * b.tracker.mean) << name;
-    EXPECT_LT(b.fused.mean, 1.5) << name;
-    for (std::size_t k = 8; k < b.fused.px.size(); ++k)
-      EXPECT_LE(b.fused.px[k], b.tracker.px[k] + 1.0) << name << ", frame " << k;
+    EXPECT_LT(b.fused.mean, 1.2) << name;
+    EXPECT_EQ(b.worse, 0) << name;
   }
 }
 

@@ -117,3 +117,66 @@ TEST(PoseFusion, NothingBeforeTheTrackerAndAfterAReset) {
 
 }  // namespace
 }  // namespace lumar::tracking
+
+namespace lumar::tracking {
+namespace {
+
+// An absolute fix worth W tracker samples, on a fused pose worth w of them, moves it by
+// W / (w + W) of the way. A frame later the fix's variance 1/W has grown by the process
+// noise q = g^2 / (1 - g), and the tracker pulls by 1 / (w + 1 / (1/W + q)) of the way.
+TEST(PoseFusion, AFixIsWeighedByItsWorthAndThenHoldsTheTrackerBack) {
+  const double gain = 0.05, worth = 100;
+  PoseFusion fusion({.tracker_gain = gain, .fix_worth = worth});
+  const Pose tracked = Pose{axis_angle_deg({1, 0, 0}, 2.0), {}} * truth(0);
+  fusion.update(std::nullopt, tracked);  // worth 2 after one sample (its gain: 1/2)
+  const Pose fused = *fusion.fix(truth(0));
+  EXPECT_NEAR(rotation_angle_deg(fused.rotation, truth(0).rotation), 2.0 * 2 / (2 + worth), 1e-9);
+  EXPECT_NEAR(rotation_angle_deg(fused.rotation, tracked.rotation), 2.0 * worth / (2 + worth), 1e-9);
+  // The next frame: the video moves it exactly, the tracker is 1 degree off the result.
+  const Pose moved = video(fused, 1);
+  const Pose after = *fusion.update(moved, Pose{axis_angle_deg({0, 0, 1}, 1.0), {}} * moved);
+  const double q = gain * gain / (1 - gain);
+  EXPECT_NEAR(rotation_angle_deg(after.rotation, moved.rotation), 1.0 / (2 + 1 / (1 / worth + q)), 1e-6);
+  // After a gap the fixes are forgotten: the tracker is weighed as at the start.
+  fusion.restart_mean();
+  const Pose before = *fusion.pose();
+  const Pose gap = *fusion.update(before, Pose{axis_angle_deg({0, 0, 1}, 1.0), {}} * before);
+  EXPECT_NEAR(rotation_angle_deg(gap.rotation, before.rotation), 0.5, 1e-6);
+}
+
+// A perfect video, the tracker with 0.75 degrees of white noise, and every 24 frames a fix
+// with the noise its worth says (sigma / sqrt(400)): the fixes hold the fused pose far
+// below the tracker's settled sigma * sqrt(g / (2 - g)), and not below their own noise.
+TEST(PoseFusion, FixesHoldTheFusedPoseNearTheirOwnAccuracy) {
+  const double sigma = 0.75, gain = 0.035, worth = 400;
+  double rms[2];
+  for (int with_fixes : {0, 1}) {
+    PoseFusion fusion({.tracker_gain = gain, .fix_worth = worth});
+    std::mt19937 rng(11);
+    fusion.update(std::nullopt, noisy(truth(0), sigma, rng));
+    double sum2 = 0;
+    int n = 0;
+    for (int k = 1; k < 20000; ++k) {
+      fusion.update(video(*fusion.pose(), k), noisy(truth(k), sigma, rng));
+      if (with_fixes && k % 24 == 0) fusion.fix(noisy(truth(k), sigma / std::sqrt(worth), rng));
+      if (k > 1000) sum2 += std::pow(rotation_angle_deg(fusion.pose()->rotation, truth(k).rotation), 2), ++n;
+    }
+    rms[with_fixes] = std::sqrt(sum2 / n);
+  }
+  std::printf("settled RMS: %.4f deg without fixes (closed form %.4f), %.4f deg with a fix every 24 frames\n", rms[0],
+              sigma * std::sqrt(gain / (2 - gain)), rms[1]);
+  EXPECT_NEAR(rms[0] / (sigma * std::sqrt(gain / (2 - gain))), 1.0, 0.08);
+  EXPECT_LT(rms[1], 0.5 * rms[0]);
+  EXPECT_GT(rms[1], 0.5 * sigma / std::sqrt(worth));
+}
+
+TEST(PoseFusion, FixesWorthNothingAreIgnoredAndANegativeWorthIsRefused) {
+  PoseFusion fusion({.tracker_gain = 0.05, .fix_worth = 0});
+  fusion.update(std::nullopt, truth(0));
+  EXPECT_NEAR(rotation_angle_deg(fusion.fix(truth(10))->rotation, truth(0).rotation), 0.0, 1e-12);
+  EXPECT_THROW(PoseFusion({.tracker_gain = 0.05, .fix_worth = -1}), InputError);
+  EXPECT_THROW(PoseFusion({.tracker_gain = 0.05, .fix_worth = std::nan("")}), InputError);
+}
+
+}  // namespace
+}  // namespace lumar::tracking

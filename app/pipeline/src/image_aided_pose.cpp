@@ -7,6 +7,8 @@
 
 #include "lumar/base/error.h"
 #include "lumar/calib/board_pose.h"
+#include "pose_from_points.h"
+#include "proxy_point.h"
 
 namespace lumar::pipeline {
 
@@ -24,12 +26,18 @@ std::vector<cv::Point2f> normalised(const CameraIntrinsics& camera, const std::v
 
 }  // namespace
 
-ImageAidedPose::ImageAidedPose(const CameraIntrinsics& camera, const Mesh& proxy, const ImageAidedSettings& settings)
+ImageAidedPose::ImageAidedPose(const CameraIntrinsics& camera, const Mesh& proxy, const ImageAidedSettings& settings,
+                               RoomPrediction predict)
     : camera_(camera), settings_(settings), fusion_(settings.fusion) {
   if (proxy.triangle_count() == 0)
     throw InputError("image-aided tracking needs the scene's proxy room: its corners' depth comes from it");
+  if (settings.align_every < 0)
+    throw InputError("--align-every: the frames between absolute fixes must be >= 0, not " +
+                     std::to_string(settings.align_every));
   proxy_.add_static(proxy);
   proxy_.commit();
+  if (predict && settings.fusion.fix_worth > 0)
+    alignment_.emplace(camera, proxy_, std::move(predict), settings.alignment);
 }
 
 std::optional<Pose> ImageAidedPose::update(const capture::Frame& frame, const std::optional<Pose>& tracker) {
@@ -40,8 +48,10 @@ std::optional<Pose> ImageAidedPose::update(const capture::Frame& frame, const st
     fusion_.reset();
     corners_.clear();
     points_.clear();
+    fix_due_ = true;
   } else if (frame.index > last_index_ + 1) {
     fusion_.restart_mean();
+    fix_due_ = true;
   }
   cv::Mat grey;
   cv::cvtColor(frame.image, grey, cv::COLOR_BGR2GRAY);
@@ -49,6 +59,10 @@ std::optional<Pose> ImageAidedPose::update(const capture::Frame& frame, const st
   tracked_.clear();
   if (fusion_.pose() && !corners_.empty()) visual = pose_from_video(grey, *fusion_.pose(), tracker);
   last_fused_ = fusion_.update(visual, tracker);
+  ++frames_since_fix_try_;
+  if (last_fused_ && alignment_ &&
+      (fix_due_ || (settings_.align_every > 0 && frames_since_fix_try_ >= settings_.align_every)))
+    try_fix(frame.image);
   ++stats_.frames;
   if (last_fused_)
     anchor(grey, *last_fused_);
@@ -87,27 +101,26 @@ std::optional<Pose> ImageAidedPose::pose_from_video(const cv::Mat& grey, const P
       points.push_back(points_[i]);
     }
   }
-  if (static_cast<int>(seen.size()) < settings_.min_inliers) return std::nullopt;
-
-  std::vector<int> inliers;
-  const bool solved =
-      cv::solvePnPRansac(points, normalised(camera_, seen), cv::Matx33d::eye(), cv::noArray(), rvec, tvec, true, 100,
-                         float(settings_.ransac_px / camera_.fx), 0.999, inliers, cv::SOLVEPNP_ITERATIVE);
-  if (!solved || static_cast<int>(inliers.size()) < settings_.min_inliers) return std::nullopt;
-  // RANSAC only chooses the inliers. Its pose may be the mirror image that puts the points
-  // behind the camera (reprojection cannot tell them apart), so the pose is refined on the
-  // inliers from the guess, which is near the answer.
-  std::vector<cv::Point3f> in_points;
-  std::vector<cv::Point2f> in_seen;
-  for (int i : inliers) in_points.push_back(points[i]), in_seen.push_back(seen[i]);
-  calib::pose_to_rvec_tvec(guess.inverse(), rvec, tvec);
-  cv::solvePnPRefineLM(in_points, normalised(camera_, in_seen), cv::Matx33d::eye(), cv::noArray(), rvec, tvec);
-  const Pose pose = calib::pose_from_rvec_tvec(rvec, tvec).inverse();
-  if (!pose.is_finite() || rotation_angle_deg(pose.rotation, guess.rotation) > settings_.max_disagree_deg)
+  const auto solved = pose_from_points(points, normalised(camera_, seen), guess, settings_.ransac_px / camera_.fx, 100,
+                                       settings_.min_inliers);
+  if (!solved || rotation_angle_deg(solved->T_world_camera.rotation, guess.rotation) > settings_.max_disagree_deg)
     return std::nullopt;
+  const std::vector<int>& inliers = solved->inliers;
   for (int i : inliers) tracked_.push_back(seen[i]);
   stats_.inliers += (inliers.size() - stats_.inliers) / (++stats_.visual_frames);
-  return pose;
+  return solved->T_world_camera;
+}
+
+void ImageAidedPose::try_fix(const cv::Mat& image) {
+  frames_since_fix_try_ = 0;
+  fix_due_ = false;
+  ++stats_.fix_attempts;
+  const auto fix = alignment_->align(image, *last_fused_);
+  if (!fix || rotation_angle_deg(fix->T_world_camera.rotation, last_fused_->rotation) > settings_.max_fix_offset_deg ||
+      glm::length(fix->T_world_camera.translation - last_fused_->translation) > settings_.max_fix_offset_m)
+    return;
+  ++stats_.fixes;
+  last_fused_ = fusion_.fix(fix->T_world_camera);
 }
 
 void ImageAidedPose::anchor(const cv::Mat& grey, const Pose& fused) {
@@ -125,19 +138,11 @@ void ImageAidedPose::anchor(const cv::Mat& grey, const Pose& fused) {
   const std::vector<cv::Point2f> rays = normalised(camera_, corners);
   corners_.clear();
   points_.clear();
-  for (std::size_t i = 0; i < corners.size(); ++i) {
-    Ray ray;
-    const glm::dvec3 d = fused.rotation * glm::dvec3(rays[i].x, rays[i].y, 1.0);
-    ray.origin = glm::vec3(fused.translation);
-    ray.direction = glm::vec3(d);
-    const auto hit = proxy_.intersect(ray);
-    if (!hit || hit->back_face) continue;
-    // A grazing view of a surface puts a corner's depth far off for a small error.
-    if (std::abs(glm::dot(glm::normalize(glm::dvec3(ray.direction)), glm::dvec3(hit->normal))) < 0.15) continue;
-    const glm::dvec3 p = fused.translation + double(hit->t) * d;
-    corners_.push_back(corners[i]);
-    points_.emplace_back(float(p.x), float(p.y), float(p.z));
-  }
+  for (std::size_t i = 0; i < corners.size(); ++i)
+    if (const auto point = point_on_proxy(proxy_, fused, rays[i])) {
+      corners_.push_back(corners[i]);
+      points_.push_back(*point);
+    }
 }
 
 }  // namespace lumar::pipeline

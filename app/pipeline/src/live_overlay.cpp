@@ -64,7 +64,8 @@ LiveOverlay::LiveOverlay(const LiveOverlayOptions& o) {
   loop_ = std::make_unique<LiveLoop>(std::move(live.source), std::move(driver), rig, settings);
   if (o.steady_with_video) {
     if (overlay_->scene().room.triangle_count() > 0)
-      fused_ = std::make_unique<ImageAidedPose>(camera, overlay_->scene().room, o.image_aided);
+      fused_ =
+          std::make_unique<ImageAidedPose>(camera, overlay_->scene().room, o.image_aided, overlay_->room_prediction());
     else
       spdlog::warn(
           "the scene has no proxy room, which the video's corners need for their depth: the tracker's "

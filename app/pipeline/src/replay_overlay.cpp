@@ -51,7 +51,8 @@ void ReplayOverlay::set_pose_source(PoseSource source) {
   pose_source_ = source;
   fused_.reset();
   if (source == PoseSource::Fused)
-    fused_ = std::make_unique<ImageAidedPose>(replay_.session().camera, scene().room, image_aided_);
+    fused_ = std::make_unique<ImageAidedPose>(replay_.session().camera, scene().room, image_aided_,
+                                              overlay_->room_prediction());
 }
 
 std::optional<Pose> ReplayOverlay::camera_pose(const capture::Frame& frame) {

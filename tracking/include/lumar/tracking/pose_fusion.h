@@ -9,6 +9,13 @@
 // sigma_t * sqrt(g / (2 - g)) (g = the gain); a video drifting by d per frame adds about
 // d / g. Until 1/g frames have passed the gain is 1/(n + 1), the running mean of the
 // tracker's offset from the video's path, so that the start needs no settling.
+//
+// An absolute fix (the frame aligned with the room the proxy predicts) may come too. It
+// is weighed as `fix_worth` tracker samples against what the fused pose is worth then
+// (1/gain tracker samples, plus the fixes before it); a fix's worth fades as the video
+// drifts (its variance grows each frame by the process noise g^2/(1-g) that gives the
+// tracker's settled gain g; faster while the video is lost), and while it lasts the
+// tracker pulls that much less.
 #include <algorithm>
 #include <optional>
 
@@ -18,6 +25,9 @@ namespace lumar::tracking {
 
 struct PoseFusionSettings {
   double tracker_gain = 0.035;  // (0, 1]; 1 = the tracker alone
+  // How many tracker samples one absolute fix is worth (the ratio of their variances;
+  // >= 0, 0 = fixes are ignored).
+  double fix_worth = 400;
 };
 
 class PoseFusion {
@@ -33,6 +43,8 @@ class PoseFusion {
   // last sample stands in). `tracker`: the tracker's pose for the same frame (nullopt: none).
   // Returns the fused pose; nullopt until the tracker has given one.
   std::optional<Pose> update(const std::optional<Pose>& visual, const std::optional<Pose>& tracker);
+  // An absolute fix for the frame just updated, pulled towards as its worth says.
+  const std::optional<Pose>& fix(const Pose& absolute);
 
   // Forget everything (a seek): the next tracker pose starts again.
   void reset();
@@ -43,10 +55,14 @@ class PoseFusion {
   const std::optional<Pose>& pose() const { return fused_; }
 
  private:
+  double drift_gain() const;     // the tracker's gain once its mean has settled
+  double tracker_worth() const;  // the fused pose's worth from the tracker alone, in its samples
+
   PoseFusionSettings settings_;
   std::optional<Pose> fused_, last_tracker_;
   std::optional<Pose> motion_;  // the video's last motion per frame, in the camera's frame
   int tracker_frames_ = 0, coasted_ = 0;
+  double fixes_worth_ = 0;  // what the fixes so far are still worth, in tracker samples
 };
 
 }  // namespace lumar::tracking

@@ -18,6 +18,7 @@
 #include "lumar/base/pose.h"
 #include "lumar/capture/frame_source.h"
 #include "lumar/lighting/ray_scene.h"
+#include "lumar/pipeline/proxy_alignment.h"
 #include "lumar/scene/mesh.h"
 #include "lumar/tracking/pose_fusion.h"
 
@@ -32,13 +33,19 @@ struct ImageAidedSettings {
   // Lucas-Kanade's least eigenvalue per window pixel below which a corner is not tracked:
   // above the sensor noise of a flat wall, whose "corners" would stay where they were put.
   double min_eigen = 1e-4;
+  ProxyAlignmentSettings alignment;
+  int align_every = 24;  // frames between absolute fixes (0: only at the start and after a gap)
+  // A fix further than this from the fused pose is not trusted (a wrong match).
+  double max_fix_offset_deg = 3, max_fix_offset_m = 0.1;
 };
 
 class ImageAidedPose {
  public:
   // `camera`: the video's intrinsics, with its distortion. `proxy`: the room in world
-  // metres (the scene's proxy); InputError when it is empty.
-  ImageAidedPose(const CameraIntrinsics& camera, const Mesh& proxy, const ImageAidedSettings& settings = {});
+  // metres (the scene's proxy); InputError when it is empty. `predict`: the room's
+  // radiance from a pose, for absolute fixes (empty: none; called from update()).
+  ImageAidedPose(const CameraIntrinsics& camera, const Mesh& proxy, const ImageAidedSettings& settings = {},
+                 RoomPrediction predict = {});
 
   // The fused pose for `frame`, given the tracker's for it. The same frame again (a paused
   // window) returns the same pose.
@@ -47,17 +54,22 @@ class ImageAidedPose {
   struct Stats {
     int frames = 0, visual_frames = 0;  // frames fused, and of them those the video could tell
     double inliers = 0;                 // mean PnP inliers over the visual frames
+    int fix_attempts = 0, fixes = 0;    // absolute fixes tried, and taken
   };
   const Stats& stats() const { return stats_; }
 
  private:
   std::optional<Pose> pose_from_video(const cv::Mat& grey, const Pose& last, const std::optional<Pose>& tracker);
   void anchor(const cv::Mat& grey, const Pose& fused);
+  void try_fix(const cv::Mat& image);
 
   CameraIntrinsics camera_;
   RayScene proxy_;
   ImageAidedSettings settings_;
   tracking::PoseFusion fusion_;
+  std::optional<ProxyAlignment> alignment_;
+  int frames_since_fix_try_ = 0;
+  bool fix_due_ = true;  // at the start and after a gap
   std::optional<Pose> last_tracker_, last_fused_;
   std::int64_t last_index_ = -2;
   cv::Mat last_grey_;

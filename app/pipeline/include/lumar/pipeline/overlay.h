@@ -15,6 +15,7 @@
 #include "lumar/capture/frame_source.h"
 #include "lumar/capture/session.h"
 #include "lumar/pipeline/live_lighting.h"
+#include "lumar/pipeline/proxy_alignment.h"
 #include "lumar/render/compositor.h"
 #include "lumar/render/platform/context.h"
 #include "lumar/scene/loaded_scene.h"
@@ -94,6 +95,13 @@ class Overlay {
   double exposure_scale() const { return exposure_scale_; }
 
   Compositor& compositor() { return *compositor_; }
+  // The room's radiance from a pose as this overlay's renderer has it, on the thread that
+  // composites (image-aided tracking's absolute fixes); it follows set_scene.
+  RoomPrediction room_prediction() {
+    return [this](const CameraIntrinsics& camera, const Pose& T_world_camera) {
+      return compositor_->renderer().render_room_radiance(camera, T_world_camera);
+    };
+  }
   const LoadedScene& scene() const { return compositor_->scene(); }
   gl::WindowContext* window() { return window_; }
   StageTimes& times() { return times_; }  // composite() fills the rendering stages; callers the rest

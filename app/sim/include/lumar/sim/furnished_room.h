@@ -7,10 +7,11 @@
 
 namespace lumar::sim {
 
-// The proxy with its far wall (least z) 3 cm further back, a cabinet against its left wall
-// (least x), and on the floor near the sample's figurine, where the orbit looks, a box
-// and a low table on four legs. Boxes face outwards. The proxy must be a room whose
-// floor is at y = 0 (the sample room's box).
+// The proxy with its far wall (least z) 3 cm further back and a recess in it (1.0 x 0.6 m,
+// 20 cm deep, low, where the orbit sees it), a cabinet against its left wall (least x), and on the floor near the
+// sample's figurine, where the orbit looks, a box and a low table on four legs. Boxes
+// face outwards. The proxy must be a room whose floor is at y = 0 (the sample room's box)
+// with its far wall one rectangle over the room's whole width and height.
 Mesh furnished_room(const Mesh& proxy);
 
 // An axis-aligned box with outward faces, four vertices per face for flat normals.
