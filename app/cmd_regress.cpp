@@ -223,7 +223,7 @@ Outcome regress_one(const fs::path& dir, const RegressOptions& o) {
     if (!std::isnan(e.jitter_px)) s += fmt::format(", jitter at rest {:.2f} px", e.jitter_px);
     if (!std::isnan(e.lag_ms)) s += fmt::format(", lag {:.1f} ms", e.lag_ms);
     if (!std::isnan(e.overshoot_px)) s += fmt::format(", overshoot {:.2f} px", e.overshoot_px);
-    return s;
+    return s + fmt::format(", largest jump {:.2f} px", e.jump_px);
   };
   out.line += fmt::format(
       "\n  registration: tracker mean {:.2f} px, p95 {:.2f} px{}; steadied by the video (--poses fused) mean {:.2f} "
@@ -246,6 +246,7 @@ Outcome regress_one(const fs::path& dir, const RegressOptions& o) {
     out.record[std::string(name) + "_jitter_px"] = number(e->jitter_px);
     out.record[std::string(name) + "_lag_ms"] = number(e->lag_ms);
     out.record[std::string(name) + "_overshoot_px"] = number(e->overshoot_px);
+    out.record[std::string(name) + "_jump_px"] = e->jump_px;
   }
   for (const char* key : {"object_err", "edge_err", "shadow_err", "noise_ratio", "noise_floor_object_err",
                           "noise_floor_edge_err", "noise_floor_shadow_err", "all_off_object_err", "all_off_edge_err",

@@ -127,12 +127,13 @@ case_regress_sample() {
   python3 - "$TMP/json" <<'PY' || fail "registration keys"
 import json, sys
 r = json.loads(open(sys.argv[1]).read().splitlines()[0])
-for k in ("fused_mean_px", "fused_p95_px", "tracker_mean_px", "tracker_p95_px"):
+for k in ("fused_mean_px", "fused_p95_px", "tracker_mean_px", "tracker_p95_px", "fused_jump_px", "tracker_jump_px"):
     assert isinstance(r[k], float), k
 print("tracker %.2f px, fused %.2f px (p95 %.2f, %.2f)" % (r["tracker_mean_px"], r["fused_mean_px"],
                                                            r["tracker_p95_px"], r["fused_p95_px"]))
 assert r["fused_mean_px"] < 0.3 * r["tracker_mean_px"], "the video's help shows"
 assert r["fused_p95_px"] < r["tracker_p95_px"]
+assert r["fused_jump_px"] < 1.0 < r["tracker_jump_px"], "the fused poses do not jump, the tracker's do"
 PY
 }
 

@@ -52,10 +52,11 @@ Both measure(const std::filesystem::path& recording, const pipeline::ReplayOverl
     }
   std::printf(
       "%s: tracker mean %.2f px, p95 %.2f; fused mean %.2f px, p95 %.2f, jitter %.2f px, lag %.1f ms, "
-      "overshoot %.2f px (tracker: %.2f px, %.1f ms, %.2f px); %d frames worse by over 1 px:%s\n",
+      "overshoot %.2f px, largest jump %.2f px (tracker: %.2f px, %.1f ms, %.2f px, %.2f px); %d frames worse by "
+      "over 1 px:%s\n",
       recording.filename().c_str(), b.tracker.mean, b.tracker.p95, b.fused.mean, b.fused.p95, b.fused.jitter_px,
-      b.fused.lag_ms, b.fused.overshoot_px, b.tracker.jitter_px, b.tracker.lag_ms, b.tracker.overshoot_px, b.worse,
-      which.c_str());
+      b.fused.lag_ms, b.fused.overshoot_px, b.fused.jump_px, b.tracker.jitter_px, b.tracker.lag_ms,
+      b.tracker.overshoot_px, b.tracker.jump_px, b.worse, which.c_str());
   EXPECT_EQ(b.fused.px.size(), b.tracker.px.size());
   return b;
 }
@@ -99,6 +100,8 @@ TEST(ImageAidedPose, SteadiesTheTrackerOnTheSampleRecordings) {
     EXPECT_LT(b.fused.p95, 1.0) << name;   // the issue: <= 2.5
     EXPECT_LT(b.fused.px[0], 0.5) << name << ": the first frame's fix";
     EXPECT_EQ(b.worse, 0) << name;
+    EXPECT_LT(b.fused.jump_px, 1.0) << name;
+    EXPECT_GT(b.tracker.jump_px, 5.0) << name;
   }
 }
 
@@ -123,6 +126,7 @@ TEST(ImageAidedPose, HoldsInARoomUnlikeTheProxy) {
   EXPECT_LT(b.fused.mean, 0.6);
   EXPECT_LT(b.fused.p95, 1.0);
   EXPECT_EQ(b.worse, 0);
+  EXPECT_LT(b.fused.jump_px, 1.0);  // the fixes pull without a jump
 }
 
 // Held 2 s, turned at 30 deg/s for 1 s, held: the issue's jitter, lag and overshoot.
@@ -148,11 +152,13 @@ TEST(ImageAidedPose, BridgesTenDroppedFrames) {
   const Both b = measure(recording);
   EXPECT_LT(b.fused.mean, 0.5);
   EXPECT_EQ(b.worse, 0);
+  EXPECT_LT(b.fused.jump_px, 1.0);
 }
 
 // The video cannot tell for half a second (a flat wall), or half of it moves on its own (a
 // panel walking through), or every frame is smeared by a full frame period of motion
-// (about 1.3 degrees, 12 px): no frame is worse than the tracker's by over 1 px.
+// (about 1.3 degrees, 12 px): no frame is worse than the tracker's by over 1 px, and the
+// objects never jump by over 1 px from one frame to the next (the tracker's: 17 px).
 TEST(ImageAidedPose, DegradesGracefully) {
   const std::vector<std::pair<std::string, std::function<void(sim::SynthSettings&)>>> cases{
       {"textureless",
@@ -168,6 +174,8 @@ TEST(ImageAidedPose, DegradesGracefully) {
     const Both b = measure(synthesize(name, change));
     EXPECT_LT(b.fused.mean, 1.2) << name;
     EXPECT_EQ(b.worse, 0) << name;
+    EXPECT_LT(b.fused.jump_px, 1.0) << name;
+    EXPECT_GT(b.tracker.jump_px, 5.0) << name;
   }
 }
 

@@ -15,6 +15,9 @@ namespace lumar::pipeline {
 namespace {
 
 constexpr std::int64_t kMaxDroppedFrames = 30;
+// A live source skips the frames the overlay is too slow for, a few at a time: over such
+// gaps the corners still track, so the fused pose keeps its worth.
+constexpr std::int64_t kSkippedFrames = 4;
 
 // Corners in pixels to points on the normalised image plane (distortion removed).
 std::vector<cv::Point2f> normalised(const CameraIntrinsics& camera, const std::vector<cv::Point2f>& pixels) {
@@ -49,9 +52,11 @@ std::optional<Pose> ImageAidedPose::update(const capture::Frame& frame, const st
     corners_.clear();
     points_.clear();
     fix_due_ = true;
-  } else if (frame.index > last_index_ + 1) {
+  } else if (frame.index > last_index_ + 1 + kSkippedFrames) {
     fusion_.restart_mean();
     fix_due_ = true;
+  } else if (frame.index > last_index_ + 1) {
+    fusion_.forget_motion();  // the video's last motion spans several frames
   }
   cv::Mat grey;
   cv::cvtColor(frame.image, grey, cv::COLOR_BGR2GRAY);

@@ -102,6 +102,7 @@ RegistrationError registration_error(ReplayOverlay& overlay, PoseSource source) 
     }
   }
   if (vv > 0) out.lag_ms = -1e3 * dv / vv;
+  for (std::size_t k = 1; k < m; ++k) out.jump_px = std::max(out.jump_px, glm::length(offset[k] - offset[k - 1]));
   if (!out.px.empty()) {
     std::vector<double> sorted = out.px;
     std::sort(sorted.begin(), sorted.end());

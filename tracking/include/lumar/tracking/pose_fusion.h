@@ -52,6 +52,8 @@ class PoseFusion {
   // a gap in the frames, bridged by the tracker's noisy motion, the fused pose is worth
   // about one tracker sample.
   void restart_mean();
+  // Keep everything but the video's last motion (frames were skipped: it spans several).
+  void forget_motion() { motion_.reset(); }
   const std::optional<Pose>& pose() const { return fused_; }
 
  private:

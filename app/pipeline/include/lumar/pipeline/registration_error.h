@@ -23,6 +23,9 @@ struct RegistrationError {
   // image velocity: how far behind the poses are. overshoot_px: in the half second after a motion stops, the largest
   // offset along that motion's last direction.
   double jitter_px, lag_ms, overshoot_px;
+  // The largest change of the offset from one frame to the next: how far the objects jump
+  // against the room at once (a fix taken, the video lost or found again).
+  double jump_px = 0;
 };
 
 // Every frame of `overlay`'s recording with poses from `source`; the overlay's own source
