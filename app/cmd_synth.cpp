@@ -65,8 +65,8 @@ void register_synth(CLI::App& app) {
       ->check(CLI::IsMember({"orbit", "still", "room", "rest-turn"}))
       ->capture_default_str();
   cmd->add_flag("--room-differs", s->room_differs,
-                "The video shows a room unlike the scene's proxy: a wall 3 cm off, a cabinet, a table, a box "
-                "(the overlay still gets the proxy)");
+                "The video shows a room unlike the scene's proxy: a wall 3 cm off with a recess, a cabinet, a "
+                "table, a box; --truth is rendered in it too (the overlay still gets the proxy)");
   // What goes wrong with a real camera's video (sim/video_faults.h).
   auto drop = std::make_shared<std::vector<int>>(), flat = std::make_shared<std::vector<int>>(),
        occluder = std::make_shared<std::vector<int>>();

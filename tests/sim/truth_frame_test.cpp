@@ -239,5 +239,45 @@ TEST(TruthFrame, SynthWritesTheVideoWithTheObjectsInItAndItsNoiseFloor) {
   }
 }
 
+// --room-differs --truth: the truth is rendered in the room the video shows (a table, a box,
+// a cabinet, a wall 3 cm off with a recess), not in the proxy the overlay is given. The
+// figurine's shadow and the light it reflects fall on the box beside it, so the truth's
+// ratio to the empty room differs from the plain room's there; computed on the proxy (as
+// before this test) the two ratios would be the same at every pixel.
+TEST(TruthFrame, TheTruthOfARoomUnlikeTheProxyIsRenderedInThatRoom) {
+  const Scratch scratch("truth-room-differs");
+  cv::Mat ratio[2], mask;
+  for (int differs : {0, 1}) {
+    sim::SynthSettings s;
+    s.scene = source_dir() / "data/scenes/room/scene.json";
+    s.out = scratch.dir / (differs ? "differs" : "plain");
+    s.camera = calib::load_camera_file(source_dir() / "data/camera/webcam-640x480.yml").intrinsics;
+    s.frames = 2;
+    s.supersample = 1;
+    s.codec = "ffv1";
+    s.exposure = 0.7;
+    s.truth = true;
+    s.room_differs = differs == 1;
+    sim::synthesize_recording(s);
+    cv::Mat truth = cv::imread((s.out / "truth/frame-00000.png").string(), cv::IMREAD_GRAYSCALE),
+            empty = cv::imread((s.out / "truth/empty-00000.png").string(), cv::IMREAD_GRAYSCALE);
+    mask = cv::imread((s.out / "truth/mask-00000.png").string(), cv::IMREAD_GRAYSCALE);
+    ASSERT_FALSE(truth.empty() || empty.empty() || mask.empty());
+    truth.convertTo(truth, CV_32F);
+    empty.convertTo(empty, CV_32F);
+    cv::blur(truth, truth, {5, 5});
+    cv::blur(empty, empty, {5, 5});
+    ratio[differs] = truth / cv::max(empty, 1.0f);
+  }
+  cv::Mat room;
+  cv::dilate(mask, room, cv::Mat(), cv::Point(-1, -1), 4);
+  room = room == 0;
+  cv::Mat apart;
+  cv::absdiff(ratio[0], ratio[1], apart);
+  const int differ = cv::countNonZero((apart > 0.03) & room);
+  std::printf("room pixels whose truth/empty ratio differs by over 0.03 between the two rooms: %d\n", differ);
+  EXPECT_GT(differ, 50);
+}
+
 }  // namespace
 }  // namespace lumar::test

@@ -237,10 +237,15 @@ void synthesize_recording(const SynthSettings& s) {
   const LoadedScene scene = load_scene_files(s.scene);
   if (scene.room.triangle_count() == 0) throw InputError(s.scene.string() + ": synth needs a proxy room (room.mesh)");
 
+  // The room the camera sees: the proxy, or one unlike it (furnished_room.h), which the
+  // video and the truth are both rendered from while the overlay keeps the proxy.
+  LoadedScene seen_scene = scene;
+  if (s.room_differs) seen_scene.room = furnished_room(scene.room);
+
   auto context = gl::create_headless_context();
   const CameraIntrinsics pinhole = covering_pinhole(s.camera, s.supersample);
   gl::Renderer renderer(pinhole);
-  renderer.set_room(s.room_differs ? furnished_room(scene.room) : scene.room);
+  renderer.set_room(seen_scene.room);
   renderer.set_environment(scene.map);
   std::optional<EnvironmentMap> changed_map;
   if (s.light_change) {
@@ -309,8 +314,8 @@ void synthesize_recording(const SynthSettings& s) {
     if (scene.objects.empty()) throw InputError(s.scene.string() + ": --truth needs objects in the scene");
     RadianceSettings radiance = reference_radiance_settings();
     radiance.map_height = 128;
-    truth_room = scene_radiance(scene, radiance);
-    truth = std::make_unique<CompositeReference>(*truth_room, scene.objects);
+    truth_room = scene_radiance(seen_scene, radiance);
+    truth = std::make_unique<CompositeReference>(*truth_room, seen_scene.objects);
   }
   const bool animated =
       std::any_of(scene.objects.begin(), scene.objects.end(), [](const LoadedObject& o) { return !o.path.empty(); });
