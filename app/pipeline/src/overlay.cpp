@@ -9,6 +9,8 @@
 
 #include <spdlog/spdlog.h>
 
+#include <opencv2/core.hpp>
+
 #include "lumar/base/error.h"
 #include "lumar/calib/camera_blur.h"
 #include "lumar/calib/sensor_noise.h"
@@ -129,6 +131,7 @@ void Overlay::set_scene(std::shared_ptr<const LoadedScene> scene) {
   compositor_->set_features(features);
   compositor_->renderer().set_video_radiometry(radiometry_);
   set_adapt_lighting_every(lighting_every_);
+  frames_since_clip_check_ = kClipCheckEvery, clip_warned_ = false;  // other objects may clip
 }
 
 void Overlay::play_paths(Nanos frame_time) {
@@ -175,9 +178,27 @@ OverlayFrame Overlay::composite(const capture::Frame& frame, const std::optional
   times_.antialiasing += gt.antialiasing_ms;
   times_.blur += gt.blur_ms;
   times_.readback += gt.readback_ms;
+  if (T_world_camera && ++frames_since_clip_check_ >= kClipCheckEvery) measure_clipping(out.composite, *T_world_camera);
   ++times_.frames;
   if (!first_composite_) first_composite_ = std::chrono::steady_clock::now();
   return out;
+}
+
+void Overlay::measure_clipping(const cv::Mat& composite, const Pose& T_world_camera) {
+  frames_since_clip_check_ = 0;
+  const cv::Mat mask = compositor_->renderer().render_object_mask(T_world_camera);
+  const int covered = cv::countNonZero(mask);
+  if (covered == 0 || mask.size() != composite.size()) return;
+  cv::Mat white;
+  cv::inRange(composite, cv::Scalar(254, 254, 254), cv::Scalar(255, 255, 255), white);
+  objects_clipped_ = double(cv::countNonZero(white & mask)) / covered;
+  if (*objects_clipped_ > kClipWarnShare && !clip_warned_) {
+    clip_warned_ = true;
+    spdlog::warn(
+        "overlay: {:.0f} % of the objects' pixels clip to white: they are brighter than the camera records at this "
+        "exposure (a truth frame, lumar synth --truth, shows whether a real object would clip too)",
+        100.0 * *objects_clipped_);
+  }
 }
 
 std::vector<std::pair<std::string, double>> StageTimes::stages() const {

@@ -442,6 +442,9 @@ class OverlayUi {
     float exposure = float(overlay_.exposure_scale());
     if (ImGui::SliderFloat("exposure", &exposure, 0.25f, 4.0f, "%.2fx", ImGuiSliderFlags_Logarithmic))
       overlay_.set_exposure_scale(exposure), dirty_ = true;
+    if (const auto clipped = overlay_.objects_clipped(); clipped && *clipped > pipeline::Overlay::kClipWarnShare)
+      ImGui::TextColored(ImVec4(1.0f, 0.6f, 0.2f, 1.0f), "%.0f %% of the objects' pixels clip to white",
+                         100.0 * *clipped);
   }
 
   // The knobs that trade speed for accuracy, the pose filter, and what to draw over the video.

@@ -91,7 +91,10 @@ class Overlay {
   // lighting (OverlaySettings::adapt_lighting_every); 0: off, back to the map's light.
   void set_adapt_lighting_every(int every_n_frames);
   // Scales the objects' brightness against the video's (1: the session's exposure).
-  void set_exposure_scale(double scale) { exposure_scale_ = scale; }
+  void set_exposure_scale(double scale) {
+    exposure_scale_ = scale;
+    frames_since_clip_check_ = kClipCheckEvery;  // measure the clipping again on the next frame
+  }
   double exposure_scale() const { return exposure_scale_; }
 
   Compositor& compositor() { return *compositor_; }
@@ -109,6 +112,14 @@ class Overlay {
   std::optional<std::chrono::steady_clock::time_point> first_composite_time() const { return first_composite_; }
   const StageTimes& times() const { return times_; }
   int frames_without_pose() const { return frames_without_pose_; }
+  // The share of the objects' pixels that clip to white in every channel, measured on the
+  // first frame with a pose and every kClipCheckEvery frames after it (nullopt before).
+  // Over kClipWarnShare a warning says so, once: the objects are brighter than the camera
+  // records at this exposure (under a sun, say); whether a real object would clip too, a
+  // truth frame tells (docs/ground_truth.md).
+  static constexpr int kClipCheckEvery = 30;
+  static constexpr double kClipWarnShare = 0.05;
+  std::optional<double> objects_clipped() const { return objects_clipped_; }
   const LiveLighting* live_lighting() const { return live_lighting_ ? &*live_lighting_ : nullptr; }
   // The video's radiometry as the renderer has it now (noise and blur once measured).
   const gl::VideoRadiometry& video_radiometry() const { return radiometry_; }
@@ -134,6 +145,10 @@ class Overlay {
   StageTimes times_;
   std::optional<std::chrono::steady_clock::time_point> first_composite_;
   int frames_without_pose_ = 0;
+  std::optional<double> objects_clipped_;
+  int frames_since_clip_check_ = kClipCheckEvery;
+  bool clip_warned_ = false;
+  void measure_clipping(const cv::Mat& composite, const Pose& T_world_camera);
 };
 
 // One line per stage: mean milliseconds per frame and share of the total.
