@@ -133,6 +133,25 @@ TEST_F(ObjectPose, StandingOutsideTheMovementBoxOrTheRoomIsWarned) {
   EXPECT_NE(outside.find("reaches outside the proxy room"), std::string::npos) << outside;
 }
 
+// The courtyard's proxy is a ground plane: open upwards, so objects standing on it are
+// inside it, and the scene loads without a warning.
+TEST_F(ObjectPose, AGroundPlaneBoundsNothingAlongItsNormal) {
+  std::ostringstream log;
+  auto sink = std::make_shared<spdlog::sinks::ostream_sink_mt>(log);
+  spdlog::default_logger()->sinks().push_back(sink);
+  const LoadedScene courtyard = load_scene_files(test::source_dir() / "data/scenes/courtyard/scene.json");
+  spdlog::default_logger()->sinks().pop_back();
+  EXPECT_EQ(log.str(), "");
+  ASSERT_EQ(courtyard.objects.size(), 2u);
+  EXPECT_TRUE(courtyard.distant());
+  EXPECT_NEAR(courtyard.room.bounds().second.y - courtyard.room.bounds().first.y, 0.0, 1e-9);
+  // The sphere rests on the ground.
+  glm::dvec3 lo(1e9);
+  for (const glm::vec3& p : courtyard.objects[1].model.positions)
+    lo = glm::min(lo, glm::dvec3(courtyard.objects[1].T_world_model * glm::dvec4(glm::dvec3(p), 1.0)));
+  EXPECT_NEAR(lo.y, 0.0, 1e-6);
+}
+
 constexpr const char* kWalkPose =
     R"({"yaw_pitch_roll_deg": [20, 0, 90], "scale": 0.002, "model_origin": "bottom-centre", "on_floor": true})";
 constexpr const char* kWalkPath = R"([{"t": 0.5, "translation": [-0.8, 0.3, 0.6]},

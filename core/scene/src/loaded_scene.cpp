@@ -1,5 +1,7 @@
 #include "lumar/scene/loaded_scene.h"
 
+#include <limits>
+
 #include <spdlog/spdlog.h>
 
 #include <glm/gtc/matrix_transform.hpp>
@@ -76,9 +78,13 @@ void warn_if_outside(const Scene& manifest, const Mesh& model, const glm::dmat4&
   if (!inside(lo, hi, manifest.movement_min, manifest.movement_max, 1e-3))
     spdlog::warn("{}: stands outside the movement box, where its lighting is extrapolated", key);
   if (room.triangle_count() > 0) {
-    const auto [room_lo, room_hi] = room.bounds();
-    if (!inside(lo, hi, glm::dvec3(room_lo), glm::dvec3(room_hi), 1e-3))
-      spdlog::warn("{}: reaches outside the proxy room", key);
+    glm::dvec3 room_lo(room.bounds().first), room_hi(room.bounds().second);
+    // A flat proxy (a ground plane) is open along its normal: it bounds nothing there.
+    for (int axis = 0; axis < 3; ++axis)
+      if (room_hi[axis] - room_lo[axis] < 1e-6)
+        room_lo[axis] = -std::numeric_limits<double>::infinity(),
+        room_hi[axis] = std::numeric_limits<double>::infinity();
+    if (!inside(lo, hi, room_lo, room_hi, 1e-3)) spdlog::warn("{}: reaches outside the proxy room", key);
   }
 }
 
