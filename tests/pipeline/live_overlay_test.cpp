@@ -212,12 +212,6 @@ TEST(LiveOverlay, SteadiesANoisyTrackerWithTheVideo) {
   const std::filesystem::path& dir = long_still_recording();
   const capture::RecordingReplay replay(dir);
   const Pose truth = *replay.true_camera_pose(0);
-  const LoadedScene scene = load_scene_files(test::source_dir() / "data/scenes/room/scene.json");
-  std::vector<glm::dvec3> points;
-  const LoadedObject& object = scene.objects[0];
-  for (std::size_t i = 0; i < object.model.positions.size(); i += 97)
-    points.emplace_back(object.T_world_model * glm::dvec4(glm::dvec3(object.model.positions[i]), 1.0));
-  const CameraIntrinsics pinhole = replay.session().camera.without_distortion();
   double mean[2] = {0, 0};
   int frames[2] = {0, 0};
   for (int steady : {0, 1}) {
@@ -228,9 +222,12 @@ TEST(LiveOverlay, SteadiesANoisyTrackerWithTheVideo) {
     pipeline::LiveOverlayOptions lo = live_options(dir, emulator);
     lo.steady_with_video = steady == 1;
     pipeline::LiveOverlay live(lo);
+    // Where the objects' points project, as registration_error measures it.
+    const Compositor& compositor = live.overlay().compositor();
     live.run([&](const pipeline::OverlayFrame& f) {
       if (!f.T_world_camera) return true;
-      mean[steady] += pipeline::projection_error_px(pinhole, points, *f.T_world_camera, truth);
+      mean[steady] += pipeline::projection_error_px(compositor.output_camera(), compositor.object_points(),
+                                                    *f.T_world_camera, truth);
       ++frames[steady];
       return true;
     });

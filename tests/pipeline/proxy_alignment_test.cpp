@@ -16,14 +16,6 @@
 namespace lumar {
 namespace {
 
-std::vector<glm::dvec3> object_points(const LoadedScene& scene) {
-  std::vector<glm::dvec3> points;
-  const LoadedObject& object = scene.objects[0];
-  for (std::size_t i = 0; i < object.model.positions.size(); i += 97)
-    points.emplace_back(object.T_world_model * glm::dvec4(glm::dvec3(object.model.positions[i]), 1.0));
-  return points;
-}
-
 struct Aligned {
   pipeline::ReplayOverlay overlay{test::source_dir() / "recordings/orbit"};
   RayScene proxy;
@@ -38,8 +30,9 @@ struct Aligned {
 TEST(ProxyAlignment, FindsTheCameraFromTheTrackersGuess) {
   Aligned a;
   const auto& replay = a.overlay.replay();
-  const CameraIntrinsics pinhole = replay.session().camera.without_distortion();
-  const auto points = object_points(a.overlay.scene());
+  // Where the objects' points project, as registration_error measures it.
+  const CameraIntrinsics& pinhole = a.overlay.compositor().output_camera();
+  const auto& points = a.overlay.compositor().object_points();
   auto frames = replay.open_frames();
   capture::Frame frame;
   double sum_tracker = 0, sum = 0, worst = 0, ms = 0, inliers = 0;

@@ -49,8 +49,8 @@ std::optional<ProxyAlignment::Result> ProxyAlignment::align(const cv::Mat& frame
 
   // Corners of the prediction, far enough from the border for their whole search.
   const int half = settings_.patch_px / 2, reach = half + settings_.search_px;
-  cv::Mat inside(predicted.size(), CV_8U, cv::Scalar(0));
   if (predicted.cols <= 2 * reach || predicted.rows <= 2 * reach) return std::nullopt;
+  cv::Mat inside(predicted.size(), CV_8U, cv::Scalar(0));
   inside(cv::Rect(reach, reach, predicted.cols - 2 * reach, predicted.rows - 2 * reach)).setTo(255);
   std::vector<cv::Point2f> corners;
   cv::goodFeaturesToTrack(predicted, corners, settings_.max_corners, 0.01, std::max(8, predicted.cols / 60), inside, 3);

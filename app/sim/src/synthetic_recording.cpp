@@ -7,6 +7,7 @@
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+#include <optional>
 
 #include "lumar/base/color.h"
 #include "lumar/base/error.h"
@@ -239,8 +240,9 @@ void synthesize_recording(const SynthSettings& s) {
 
   // The room the camera sees: the proxy, or one unlike it (furnished_room.h), which the
   // video and the truth are both rendered from while the overlay keeps the proxy.
-  LoadedScene seen_scene = scene;
-  if (s.room_differs) seen_scene.room = furnished_room(scene.room);
+  std::optional<LoadedScene> furnished;
+  if (s.room_differs) furnished.emplace(scene), furnished->room = furnished_room(scene.room);
+  const LoadedScene& seen_scene = furnished ? *furnished : scene;
 
   auto context = gl::create_headless_context();
   const CameraIntrinsics pinhole = covering_pinhole(s.camera, s.supersample);

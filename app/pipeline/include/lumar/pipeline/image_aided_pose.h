@@ -8,7 +8,8 @@
 // tracking::PoseFusion. Where the video cannot tell (too few corners or inliers, a jump
 // the tracker does not share), its last motion goes on while the fused pose slides back
 // to the tracker's, without a jump; over dropped frames (up to 30) the tracker's motion
-// bridges the gap (over a few, as a live source skips them, the corners still track). Frames must come in order; a seek starts again from the tracker.
+// bridges the gap (over a few, as a live source skips them, the corners still track).
+// Frames must come in order; a seek starts again from the tracker.
 #include <cstdint>
 #include <opencv2/core.hpp>
 #include <optional>
