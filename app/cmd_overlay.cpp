@@ -23,9 +23,9 @@ namespace {
 
 struct OverlayOptions {
   std::string recording, scene, out, frames_dir, contact_sheet, poses = "fused", undistort = "same";
-  std::string filter = "none", without;
-  double blur_sigma = -1.0;
-  bool window = false, no_cache = false, allow_incomplete = false, paused = false;
+  std::string filter = "none";
+  CompositeOptions composite;
+  bool window = false, no_cache = false, allow_incomplete = false, paused = false, serial = false;
   std::string save_scene, screenshot, stats_json;
   int max_frames = 0;
   int adapt_lighting = 0, adapt_lighting_cells = 32;
@@ -42,7 +42,7 @@ pipeline::OverlaySettings overlay_settings(const OverlayOptions& o, bool window)
   s.adapt_lighting_cells = o.adapt_lighting_cells;
   s.window = window;
   s.volume_cache = !o.no_cache;
-  apply_composite_features(o.without, o.blur_sigma, s);
+  apply_composite_options(o.composite, s);
   return s;
 }
 
@@ -166,11 +166,15 @@ void run_replay(const OverlayOptions& o) {
           fmt::format("overlay: the window closed after {} of {} frames had played; no output written", done, total));
   } else {
     auto sink = frame_sink(outputs);
-    overlay.run(o.max_frames, [&](const pipeline::OverlayFrame& f) {
-      const bool go_on = sink(f);
-      progress.update(++done);
-      return go_on && !stop_requested();
-    });
+    // Pipelined, the sink (encoding, files) runs on its own thread (ReplayOverlay::run).
+    overlay.run(
+        o.max_frames,
+        [&](const pipeline::OverlayFrame& f) {
+          const bool go_on = sink(f);
+          progress.update(++done);
+          return go_on && !stop_requested();
+        },
+        !o.serial);
   }
   progress.finish();
   if (stop_requested())
@@ -247,10 +251,14 @@ void register_overlay(CLI::App& app) {
   cmd->add_flag("--allow-incomplete", o->allow_incomplete,
                 "Replay a recording that was never closed (killed or crashed): its closed frames");
   cmd->add_option("--max-frames", o->max_frames, "Stop after this many frames (0 = all)")->capture_default_str();
-  add_composite_feature_options(cmd, o->without, o->blur_sigma);
+  add_composite_options(cmd, o->composite);
   cmd->add_flag("--no-cache", o->no_cache,
                 "Build the irradiance volume and the shadow lines without reading or writing the cache "
                 "($XDG_CACHE_HOME/lumar)");
+  cmd->add_flag("--serial", o->serial,
+                "A recording without a window: decode, composite and write each frame one after another on one "
+                "thread, instead of the three stages on their own threads (the baseline the pipeline is measured "
+                "against; docs/results.md)");
   // The live path (pipeline/live_overlay.h): --source and --tracker instead of --recording.
   pipeline::LiveOverlayOptions& live = o->live;
   cmd->add_option("--source", live.in.source, "Live: video:FILE, images:DIR, v4l2:/dev/videoN or recording:DIR");

@@ -35,8 +35,7 @@ struct RegressOptions {
   std::string root = "recordings";
   std::string scene;  // instead of the one the session names (a live recording names none)
   bool update = false, no_cache = false, allow_incomplete = false, json = false;
-  std::string without;  // the composite features switched off (commands.h)
-  double blur_sigma = -1.0;
+  CompositeOptions composite;  // the composite features switched off, the shading (commands.h)
 };
 
 // Golden frames' size for --update: big enough that a shadow and an edge count.
@@ -78,7 +77,9 @@ struct Outcome {
 std::optional<pipeline::CompositeError> composite_error(const fs::path& dir, const RegressOptions& o,
                                                         const std::string& without) {
   pipeline::ReplayOverlaySettings settings;
-  apply_composite_features(without, o.blur_sigma, settings.overlay);
+  CompositeOptions composite = o.composite;
+  composite.without = without;
+  apply_composite_options(composite, settings.overlay);
   settings.scene = o.scene;
   settings.overlay.volume_cache = !o.no_cache;
   settings.allow_incomplete = o.allow_incomplete;
@@ -110,7 +111,7 @@ Outcome regress_one(const fs::path& dir, const RegressOptions& o) {
 
   pipeline::ReplayOverlaySettings settings;
   settings.scene = o.scene;
-  apply_composite_features(o.without, o.blur_sigma, settings.overlay);
+  apply_composite_options(o.composite, settings.overlay);
   settings.overlay.volume_cache = !o.no_cache;
   settings.allow_incomplete = o.allow_incomplete;
   pipeline::ReplayOverlay overlay(dir, settings);
@@ -199,7 +200,7 @@ Outcome regress_one(const fs::path& dir, const RegressOptions& o) {
   const double render_limit = expected.at("render_projection_mean_px_max").get<double>();
   // Older expectations have no limit for the fused poses: those are then only reported.
   const double fused_limit = expected.value("fused_projection_mean_px_max", 1e9);
-  const auto measured = composite_error(dir, o, o.without);
+  const auto measured = composite_error(dir, o, o.composite.without);
   // The same composite with every feature that closes the gap off: what they bring.
   const auto all_off = measured ? composite_error(dir, o, "all") : std::nullopt;
   Outcome out;
@@ -295,7 +296,7 @@ void register_regress(CLI::App& app) {
                 "Build the irradiance volume and the shadow lines without reading or writing the cache");
   cmd->add_flag("--json", o->json,
                 "Print one JSON object per recording on stdout (keys: docs/ground_truth.md); the lines go to stderr");
-  add_composite_feature_options(cmd, o->without, o->blur_sigma);
+  add_composite_options(cmd, o->composite);
   cmd->add_flag("--update", o->update,
                 "Write new golden frames and expected.json instead of comparing (thresholds: docs/formats.md, "
                 "\"Regression expectations\")");

@@ -14,16 +14,21 @@ std::map<CLI::App*, std::function<void()>>& actions() {
 
 void add_action(CLI::App* sub, std::function<void()> run) { actions()[sub] = std::move(run); }
 
-void add_composite_feature_options(CLI::App* cmd, std::string& without, double& blur_sigma_px) {
-  cmd->add_option("--without", without,
+void add_composite_options(CLI::App* cmd, CompositeOptions& o) {
+  cmd->add_option("--without", o.without,
                   "Switch off what makes the objects look like the camera's pixels: a comma-separated list of "
                   "antialiasing, self-occlusion, noise, blur, bounce, or all (docs/ground_truth.md)");
-  cmd->add_option("--blur-sigma", blur_sigma_px,
+  cmd->add_option("--blur-sigma", o.blur_sigma_px,
                   "The camera's blur as a Gaussian of this many output pixels (default: estimated from the video)")
       ->check(CLI::Range(0.0, 4.0));
+  cmd->add_option("--shading", o.shading,
+                  "Where the objects' light from the irradiance volume is evaluated: pixel (every covered pixel) or "
+                  "vertex (their vertices, again only when they move; docs/irradiance.md)")
+      ->capture_default_str();
 }
 
-void apply_composite_features(const std::string& without, double blur_sigma_px, pipeline::OverlaySettings& settings) {
+void apply_composite_options(const CompositeOptions& o, pipeline::OverlaySettings& settings) {
+  const std::string& without = o.without;
   gl::CompositeFeatures& f = settings.features;
   std::stringstream list(without);
   for (std::string name; std::getline(list, name, ',');) {
@@ -43,7 +48,10 @@ void apply_composite_features(const std::string& without, double blur_sigma_px, 
       throw InputError("--without " + without + ": unknown feature '" + name +
                        "'; use antialiasing, self-occlusion, noise, blur, bounce or all");
   }
-  if (blur_sigma_px >= 0) settings.blur_sigma_px = blur_sigma_px;
+  if (o.blur_sigma_px >= 0) settings.blur_sigma_px = o.blur_sigma_px;
+  if (o.shading != "pixel" && o.shading != "vertex")
+    throw InputError("--shading " + o.shading + ": use pixel or vertex");
+  settings.shading = o.shading == "vertex" ? ObjectShading::PerVertex : ObjectShading::PerPixel;
 }
 
 void add_live_input_options(CLI::App* cmd, pipeline::LiveInputOptions& o, const std::string& camera_help) {

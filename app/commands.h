@@ -21,10 +21,16 @@ void add_live_input_options(
     const std::string& camera_help = "Camera calibration (OpenCV YAML); default: a nominal pinhole");
 
 // --without and --blur-sigma: what makes rendered pixels look like the camera's
-// (gl::CompositeFeatures), with the same names in every command that composites.
-void add_composite_feature_options(CLI::App* cmd, std::string& without, double& blur_sigma_px);
+// (gl::CompositeFeatures); --shading: the objects' light per pixel or per vertex
+// (ObjectShading). The same names in every command that composites.
+struct CompositeOptions {
+  std::string without;
+  double blur_sigma_px = -1.0;
+  std::string shading = "pixel";
+};
+void add_composite_options(CLI::App* cmd, CompositeOptions& o);
 // Applies them to `settings`; InputError names an unknown feature.
-void apply_composite_features(const std::string& without, double blur_sigma_px, pipeline::OverlaySettings& settings);
+void apply_composite_options(const CompositeOptions& o, pipeline::OverlaySettings& settings);
 
 void register_synth(CLI::App& app);
 void register_overlay(CLI::App& app);

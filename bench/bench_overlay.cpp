@@ -6,9 +6,16 @@
 // again with them all off, so that their cost is a ratio from the same run. The walk
 // recording adds moving objects: the figurine walks across the floor beside a second
 // one, so its shadow on the floor and on the other object is traced again every frame.
+// Throughput: both recordings replayed whole as `lumar overlay` does, today's serial path
+// with per-pixel shading (the baseline of that table) against the pipelined stages with
+// per-vertex shading (ReplayOverlay::run, ObjectShading), without output and with H.264.
 #include <benchmark/benchmark.h>
+#include <unistd.h>
+
+#include <map>
 
 #include "bench_report.h"
+#include "lumar/pipeline/output_files.h"
 #include "lumar/pipeline/replay_overlay.h"
 
 using namespace lumar;
@@ -92,6 +99,54 @@ void replay_frame(benchmark::State& state, bool walk) {
   }
 }
 
+// How one replay is run: which recording, shading and threads, and whether H.264 is written.
+struct Throughput {
+  bool walk = false, vertex = false, pipelined = false, encode = false;
+  std::string label() const {  // within one recording's table
+    return std::string(pipelined ? "pipelined" : "serial") + (vertex ? ", per vertex" : ", per pixel") +
+           (encode ? ", H.264" : "");
+  }
+  std::string name() const { return std::string(walk ? "walk, " : "orbit, ") + label(); }
+};
+
+// Frames per second and latency over whole replays, through the pipeline library. One
+// overlay per recording and shading, made (and its shaders compiled) before the clock runs.
+void replay_throughput(benchmark::State& state, Throughput t) {
+  static std::map<std::pair<bool, bool>, std::unique_ptr<pipeline::ReplayOverlay>> overlays;
+  auto& overlay = overlays[{t.walk, t.vertex}];
+  if (!overlay) {
+    pipeline::ReplayOverlaySettings s;
+    s.overlay.shading = t.vertex ? ObjectShading::PerVertex : ObjectShading::PerPixel;
+    overlay = std::make_unique<pipeline::ReplayOverlay>(t.walk ? kWalk : kRecording, s);
+    overlay->run(2, [](const pipeline::OverlayFrame&) { return true; });
+  }
+  const auto& camera = overlay->compositor().output_camera();
+  const std::string video =
+      (std::filesystem::temp_directory_path() / ("lumar-bench-" + std::to_string(::getpid()) + ".mp4")).string();
+  const pipeline::StageTimes before = overlay->times();
+  for (auto _ : state) {
+    std::optional<pipeline::OverlayOutputs> outputs;
+    if (t.encode)
+      outputs.emplace(pipeline::OverlayOutputSettings{video, "", "", overlay->replay().reader().video().fps,
+                                                      cv::Size(camera.width, camera.height)});
+    overlay->run(
+        0,
+        [&](const pipeline::OverlayFrame& f) {
+          if (outputs) outputs->write(f.index, f.composite);
+          benchmark::DoNotOptimize(f.composite.data);
+          return true;
+        },
+        t.pipelined);
+    if (outputs) outputs->commit();
+  }
+  std::filesystem::remove(video);
+  const pipeline::StageTimes& after = overlay->times();
+  const double frames = after.frames - before.frames;
+  using C = benchmark::Counter;
+  state.counters["frames"] = C(frames, C::kAvgIterations);  // per pass
+  state.counters["latency_ms"] = C((after.latency - before.latency) / std::max(1.0, frames));
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -115,6 +170,17 @@ int main(int argc, char** argv) {
       ->Unit(benchmark::kMillisecond)
       ->Iterations(2)
       ->UseRealTime();
+  std::vector<Throughput> throughputs;
+  for (bool walk : {false, true})
+    for (const Throughput& t : {Throughput{walk, false, false, false}, Throughput{walk, true, false, false},
+                                Throughput{walk, true, true, false}, Throughput{walk, false, false, true},
+                                Throughput{walk, true, true, true}})
+      throughputs.push_back(t);
+  for (const Throughput& t : throughputs)
+    benchmark::RegisterBenchmark(("throughput/" + t.name()).c_str(), replay_throughput, t)
+        ->Unit(benchmark::kMillisecond)
+        ->Iterations(2)
+        ->UseRealTime();
   benchmark::Initialize(&argc, argv);
   bench::CollectingReporter reporter;
   benchmark::RunSpecifiedBenchmarks(&reporter);
@@ -157,6 +223,26 @@ int main(int argc, char** argv) {
   report.entries.push_back({"walk: replay, all stages", walk_ms});
   report.compute_ratios();
   report.save(bench::results_dir());
+
+  // Throughput per recording, against today's serial per-pixel path in the same run.
+  for (bool walk : {false, true}) {
+    bench::BenchReport table;
+    table.name = walk ? "overlay_throughput_walk" : "overlay_throughput";
+    table.title = std::string("Replay throughput at 640x480, ") + (walk ? "walk (moving objects)" : "sample orbit") +
+                  ", Mesa llvmpipe: ms per frame";
+    for (const Throughput& t : throughputs) {
+      if (t.walk != walk) continue;
+      const auto* r = reporter.find("throughput/" + t.name());
+      if (!r) return 0;
+      const double ms = r->time_ms / std::max(1.0, r->counters.at("frames"));
+      table.entries.push_back({t.label(), ms});
+      std::printf("%-40s %6.2f ms per frame  %5.1f frames/s  latency %6.1f ms\n", t.name().c_str(), ms, 1000.0 / ms,
+                  r->counters.at("latency_ms"));
+    }
+    table.baseline = table.entries.front().name;
+    table.compute_ratios();
+    table.save(bench::results_dir());
+  }
   std::printf("replay throughput: %.1f frames/s\n", 1000.0 / replay_ms);
   std::printf(
       "moving figurine with its shadow and a second object (walk): %.1f frames/s, %.2f ms per frame of which %.2f ms "

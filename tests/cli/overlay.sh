@@ -91,7 +91,7 @@ case_live_window_shows_the_panels() {
 case_stats_json_without_encoding() {
   # --stats-json alone: no output encoded, the run's figures as JSON. On the serial path a
   # frame's latency is its stages end to end, so the mean latency is their sum per frame.
-  "$LUMAR" overlay --recording "$REC" --max-frames 6 --stats-json "$TMP/stats.json" >"$TMP/log" 2>&1 ||
+  "$LUMAR" overlay --recording "$REC" --max-frames 6 --serial --stats-json "$TMP/stats.json" >"$TMP/log" 2>&1 ||
     { cat "$TMP/log"; fail "overlay --stats-json failed"; }
   [ "$(ls -A "$TMP" | grep -v -e '^stats.json$' -e '^log$')" = "" ] || fail "wrote more than the stats: $(ls -A "$TMP")"
   python3 - "$TMP/stats.json" <<'PY' || fail "bad stats file"
@@ -110,6 +110,26 @@ assert s['startup_ms'] > 0 and s['startup_ms'] > total, (s['startup_ms'], total)
 print("ok: start-up %.0f ms, %.1f frames/s" % (s['startup_ms'], s['fps']))
 PY
   grep -q "first frame composited" "$TMP/log" || fail "no start-up line"
+}
+
+case_pipelined_per_vertex() {
+  # The default, pipelined: the same frames as --serial (noise's seed is the frame's number).
+  # --shading vertex lights the figurine on the CPU once (it stands still), a stage of its own.
+  "$LUMAR" overlay --recording "$REC" --max-frames 4 --shading vertex --frames-dir "$TMP/piped" \
+    --stats-json "$TMP/stats.json" >"$TMP/log" 2>&1 || { cat "$TMP/log"; fail "pipelined overlay failed"; }
+  "$LUMAR" overlay --recording "$REC" --max-frames 4 --shading vertex --frames-dir "$TMP/serial" --serial \
+    >"$TMP/log" 2>&1 || { cat "$TMP/log"; fail "serial overlay failed"; }
+  for f in "$TMP/serial"/*.png; do
+    cmp -s "$f" "$TMP/piped/$(basename "$f")" || fail "$(basename "$f") differs between the serial and pipelined runs"
+  done
+  [ "$(ls "$TMP/piped" | wc -l)" -eq 4 ] || fail "expected 4 frames"
+  python3 - "$TMP/stats.json" <<'PY' || fail "bad stats file"
+import json, sys
+s = json.load(open(sys.argv[1]))
+assert s['frames'] == 4, s['frames']
+assert s['stages']['object light per vertex'] > 0, s['stages']
+PY
+  expect_bad_input "--shading" "$TMP/bad" -- "$LUMAR" overlay --recording "$REC" --shading facet --frames-dir "$TMP/bad"
 }
 
 case_window_without_display_fails_cleanly() {

@@ -128,7 +128,7 @@ TEST(IrradianceGpu, CompositorShadingFollowsTheObjectThroughTheSampleRoom) {
       std::make_shared<const LoadedScene>(load_scene_files(source_dir() / "data/scenes/room/scene.json"));
   const CameraIntrinsics cam = camera(120, 90, 110);
   Compositor compositor(scene, cam, cv::Mat(), cv::Mat());
-  const IrradianceVolume* v = compositor.irradiance_volume();
+  const IrradianceVolume* v = compositor.irradiance_volume().get();
   ASSERT_NE(v, nullptr);
   std::printf("sample room volume: %d probes, %d refined cells, %.0f ms to build\n", v->stats().probes,
               v->stats().refined_cells, v->stats().build_ms);
@@ -151,6 +151,51 @@ TEST(IrradianceGpu, CompositorShadingFollowsTheObjectThroughTheSampleRoom) {
   std::printf("brightness ratio between the positions: GPU %.3f, CPU %.3f\n", gpu_ratio, cpu_ratio);
   EXPECT_GT(std::abs(cpu_ratio - 1.0), 0.05);  // the positions are lit differently
   EXPECT_NEAR(gpu_ratio, cpu_ratio, 0.02 * cpu_ratio);
+}
+
+// Per-vertex shading (ObjectShading::PerVertex) against per pixel on the figurine, where
+// it stands and after it moved to where the room lights it differently: the vertices are
+// lit again when it moves, so the two agree at both places.
+TEST(IrradianceGpu, PerVertexShadingFollowsPerPixelAsTheFigurineMoves) {
+  context();
+  const auto scene =
+      std::make_shared<const LoadedScene>(load_scene_files(source_dir() / "data/scenes/room/scene.json"));
+  const CameraIntrinsics cam = camera(320, 240, 300);
+  Compositor compositor(scene, cam, cv::Mat(), cv::Mat());
+  compositor.set_features({.antialiasing = false, .self_occlusion = true, .noise = false, .blur = false});
+  compositor.set_shadows_enabled(false);  // the figurine's pixels alone
+  const cv::Mat video(cam.height, cam.width, CV_8UC3, cv::Scalar(0, 0, 0));
+  const glm::dmat4 start = scene->objects[0].T_world_model;
+  double mean[2][2] = {};  // [place][pixel, vertex]
+  for (int place = 0; place < 2; ++place) {
+    const glm::dvec3 shift = place == 0 ? glm::dvec3(0.0) : glm::dvec3(-1.1, 0.7, 1.0);
+    compositor.set_object_pose(0, glm::translate(glm::dmat4(1.0), shift) * start);
+    const glm::dvec3 centre = glm::dvec3(0.0, 0.15, 0.0) + shift;
+    const Pose eye = look_at(centre + glm::dvec3(0.2, 0.3, -0.7), centre);
+    const cv::Mat mask = compositor.renderer().render_object_mask(eye);
+    ASSERT_GT(cv::countNonZero(mask), 3000);
+    cv::Mat linear[2];
+    for (int k = 0; k < 2; ++k) {
+      compositor.set_object_shading(k == 0 ? ObjectShading::PerPixel : ObjectShading::PerVertex);
+      const cv::Mat out = compositor.composite(video, eye, 1.0);
+      out.convertTo(linear[k], CV_64FC3, 1.0 / 255.0);
+      linear[k].forEach<cv::Vec3d>([](cv::Vec3d& v, const int*) {
+        for (int c = 0; c < 3; ++c) v[c] = srgb_decode(v[c]);
+      });
+      mean[place][k] = cv::sum(cv::mean(linear[k], mask))[0] / 3.0;
+    }
+    cv::Mat diff;
+    cv::absdiff(linear[0], linear[1], diff);
+    const double mean_abs = cv::sum(cv::mean(diff, mask))[0] / 3.0;
+    std::printf("place %d: %d pixels, mean linear per pixel %.4f, per vertex %.4f, mean |diff| %.2f %%\n", place,
+                cv::countNonZero(mask), mean[place][0], mean[place][1], 100.0 * mean_abs / mean[place][0]);
+    EXPECT_NEAR(mean[place][1], mean[place][0], 0.02 * mean[place][0]);
+    EXPECT_LT(mean_abs, 0.06 * mean[place][0]);  // the shadow maps' edges soften between vertices
+  }
+  const double pixel_ratio = mean[1][0] / mean[0][0], vertex_ratio = mean[1][1] / mean[0][1];
+  std::printf("brightness ratio between the places: per pixel %.3f, per vertex %.3f\n", pixel_ratio, vertex_ratio);
+  EXPECT_GT(std::abs(pixel_ratio - 1.0), 0.05);  // the places are lit differently
+  EXPECT_NEAR(vertex_ratio, pixel_ratio, 0.02 * pixel_ratio);
 }
 
 // Not a timing assertion: reports the per-pixel cost of volume shading on this GPU.

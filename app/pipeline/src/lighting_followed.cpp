@@ -5,6 +5,7 @@
 #include "lumar/lighting/irradiance_scene.h"
 #include "lumar/lighting/shadows/shadow_methods.h"
 #include "lumar/lighting/shadows/shadow_occlusion.h"
+#include "lumar/scene/mesh.h"
 
 namespace lumar::pipeline {
 
@@ -15,10 +16,10 @@ struct Samples {  // world positions and normals of some of an object's vertices
 };
 Samples object_samples(const LoadedObject& o) {
   Samples s;
-  const glm::dmat3 normal_matrix = glm::transpose(glm::inverse(glm::dmat3(o.T_world_model)));
-  for (std::size_t i = 0; i < o.model.positions.size(); i += 13) {
-    s.positions.push_back(glm::dvec3(o.T_world_model * glm::dvec4(glm::dvec3(o.model.positions[i]), 1.0)));
-    s.normals.push_back(glm::normalize(normal_matrix * glm::dvec3(o.model.normals[i])));
+  const Mesh posed = transformed(o.model, o.T_world_model);
+  for (std::size_t i = 0; i < posed.positions.size(); i += 13) {
+    s.positions.emplace_back(posed.positions[i]);
+    s.normals.emplace_back(posed.normals[i]);
   }
   return s;
 }

@@ -58,9 +58,7 @@ LiveLighting::~LiveLighting() {
 // the first time (no other thread touches base_ while a bake is pending).
 LiveLighting::Baked LiveLighting::bake(const std::shared_ptr<const LoadedScene>& scene, const cv::Mat& ratios_bgr) {
   const auto t0 = std::chrono::steady_clock::now();
-  if (!base_)
-    base_ = scene_radiance(*scene,
-                           scene_volume_settings(scene->manifest.lighting, scene->manifest.lighting.method).radiance);
+  if (!base_) base_ = scene_base_radiance(*scene);
   MapCellScale scale{ratios_bgr.cols, ratios_bgr.rows, std::vector<glm::vec3>(ratios_bgr.total())};
   for (std::size_t k = 0; k < scale.rgb.size(); ++k) {
     const cv::Vec3d v = ratios_bgr.at<cv::Vec3d>(int(k));
@@ -89,7 +87,7 @@ void LiveLighting::update(Compositor& compositor, const cv::Mat& video_bgr8, con
   if (!scene_) {
     // The compositor's own lighting is where every fade starts from, and what restore() returns to.
     scene_ = compositor.shared_scene();
-    original_.volume = compositor.irradiance_volume_ptr();
+    original_.volume = compositor.irradiance_volume();
     original_.sh = compositor.lighting_sh();
     const auto& s = adapter_.settings();
     original_.scale = MapCellScale{s.cell_cols, s.cell_rows,

@@ -68,6 +68,7 @@ Overlay::Overlay(std::shared_ptr<const LoadedScene> scene, const CameraIntrinsic
   blur_known_ = !settings.features.blur;
   if (settings.blur_sigma_px >= 0) radiometry_.blur_sigma_px = settings.blur_sigma_px, blur_known_ = true;
   compositor_->set_features(settings.features);
+  compositor_->set_object_shading(settings.shading);
   compositor_->renderer().set_video_radiometry(radiometry_);
   lighting_cells_ = settings.adapt_lighting_cells;
   set_adapt_lighting_every(settings.adapt_lighting_every);
@@ -126,9 +127,11 @@ void Overlay::set_scene(std::shared_ptr<const LoadedScene> scene) {
   // The lighting measured so far was the old scene's map's: start again.
   live_lighting_.reset();
   const gl::CompositeFeatures features = compositor_->renderer().features();
+  const ObjectShading shading = compositor_->object_shading();
   compositor_.reset();  // its GL objects go first
   compositor_ = std::make_unique<Compositor>(std::move(scene), maps_.output, maps_.map_x, maps_.map_y, volume_cache_);
   compositor_->set_features(features);
+  compositor_->set_object_shading(shading);
   compositor_->renderer().set_video_radiometry(radiometry_);
   set_adapt_lighting_every(lighting_every_);
   frames_since_clip_check_ = kClipCheckEvery, clip_warned_ = false;  // other objects may clip
@@ -171,6 +174,7 @@ OverlayFrame Overlay::composite(const capture::Frame& frame, const std::optional
   gl::OverlayTimings gt;
   out.composite = compositor_->composite(frame.image, T_world_camera, exposure_ * exposure_scale_, &gt);
   times_.shadows += gt.shadows_ms;
+  times_.vertex_light += gt.vertex_light_ms;
   times_.upload += gt.upload_ms;
   times_.background += gt.background_ms;
   times_.depth += gt.depth_ms;
@@ -207,6 +211,7 @@ std::vector<std::pair<std::string, double>> StageTimes::stages() const {
           {"camera noise and blur", measure},
           {"lighting adaptation", lighting},
           {"shadows (moved objects)", shadows},
+          {"object light per vertex", vertex_light},
           {"upload frame", upload},
           {"background (undistort)", background},
           {"proxy depth", depth},

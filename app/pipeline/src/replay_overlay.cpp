@@ -3,8 +3,11 @@
 #include <spdlog/spdlog.h>
 
 #include <chrono>
+#include <exception>
+#include <thread>
 
 #include "lumar/base/error.h"
+#include "stage_queue.h"
 
 namespace lumar::pipeline {
 
@@ -61,7 +64,8 @@ std::optional<Pose> ReplayOverlay::camera_pose(const capture::Frame& frame) {
   return fused_ ? fused_->update(frame, tracked) : tracked;
 }
 
-void ReplayOverlay::run(int max_frames, const std::function<bool(const OverlayFrame&)>& sink) {
+void ReplayOverlay::run(int max_frames, const std::function<bool(const OverlayFrame&)>& sink, bool pipelined) {
+  if (pipelined) return run_pipelined(max_frames, sink);
   auto frames = replay_.open_frames();
   StageTimes& times = overlay_->times();
   capture::Frame frame;
@@ -82,6 +86,78 @@ void ReplayOverlay::run(int max_frames, const std::function<bool(const OverlayFr
     times.latency += ms_since(start);
     if (!go_on) break;
   }
+}
+
+namespace {
+using Clock = std::chrono::steady_clock;
+struct Decoded {
+  capture::Frame frame;
+  Clock::time_point start;  // when its decoding began: the start of its latency
+  double decode_ms = 0;
+};
+struct Composited {
+  OverlayFrame frame;
+  Clock::time_point start;
+};
+}  // namespace
+
+void ReplayOverlay::run_pipelined(int max_frames, const std::function<bool(const OverlayFrame&)>& sink) {
+  // Closing a queue ends the stream through it: the producer ran out, or a consumer stopped.
+  StageQueue<Decoded> decoded(kPipelineDepth);
+  StageQueue<Composited> composited(kPipelineDepth);
+  std::exception_ptr decode_error, sink_error;
+  double output_ms = 0, latency_ms = 0;  // the sink thread's, added to the times once it joined
+
+  std::thread decoder([&, frames = replay_.open_frames()] {
+    try {
+      for (int n = 0; (max_frames <= 0 || n < max_frames) && decoded.wait_for_room(); ++n) {
+        Decoded d;
+        d.start = Clock::now();
+        if (!frames->read(d.frame)) break;
+        d.decode_ms = ms_since(d.start);
+        if (!decoded.push(std::move(d))) break;
+      }
+    } catch (...) {
+      decode_error = std::current_exception();
+    }
+    decoded.close();
+  });
+  std::thread writer([&] {
+    try {
+      for (Composited c; composited.pop(c);) {
+        const auto t0 = Clock::now();
+        const bool go_on = sink(c.frame);
+        output_ms += ms_since(t0);
+        latency_ms += ms_since(c.start);
+        if (!go_on) break;
+      }
+    } catch (...) {
+      sink_error = std::current_exception();
+    }
+    composited.close();  // the compositing loop stops at its next push
+    decoded.close();
+  });
+  StageTimes& times = overlay_->times();
+  std::exception_ptr composite_error;
+  try {
+    for (Decoded d; decoded.pop(d);) {
+      times.decode += d.decode_ms;
+      const auto t0 = Clock::now();
+      const std::optional<Pose> pose = camera_pose(d.frame);
+      times.pose += ms_since(t0);
+      if (!composited.push(Composited{overlay_->composite(d.frame, pose), d.start})) break;
+    }
+  } catch (...) {
+    composite_error = std::current_exception();
+  }
+  decoded.close();
+  composited.close();
+  decoder.join();
+  writer.join();
+  times.output += output_ms;
+  times.latency += latency_ms;
+  for (const std::exception_ptr& e : {composite_error, sink_error, decode_error})
+    if (e) std::rethrow_exception(e);
 }
 
 }  // namespace lumar::pipeline

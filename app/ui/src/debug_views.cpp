@@ -78,7 +78,7 @@ cv::Mat draw_debug_views(const cv::Mat& composite, const Compositor& compositor,
       }
     }
   }
-  if (const IrradianceVolume* volume = compositor.irradiance_volume(); views.probes && volume) {
+  if (const IrradianceVolume* volume = compositor.irradiance_volume().get(); views.probes && volume) {
     std::vector<double> light;
     double brightest = 0;
     for (const glm::vec4& probe : volume->probes) {

@@ -21,6 +21,11 @@ std::unique_ptr<RoomRadiance> scene_radiance(const LoadedScene& scene, const Rad
   return std::make_unique<RoomRadiance>(scene.map, scene.room, settings);
 }
 
+std::unique_ptr<RoomRadiance> scene_base_radiance(const LoadedScene& scene) {
+  const LightingSettings& lighting = scene.manifest.lighting;
+  return scene_radiance(scene, scene_volume_settings(lighting, lighting.method).radiance);
+}
+
 IrradianceVolume scene_irradiance_volume(const LoadedScene& scene, const std::string& method, bool use_cache,
                                          const std::filesystem::path& cache_dir, bool* loaded) {
   const VolumeSettings settings = scene_volume_settings(scene.manifest.lighting, method);

@@ -13,6 +13,7 @@
 #include "lumar/lighting/shadows/shadow_line_cache.h"
 #include "lumar/lighting/shadows/shadow_methods.h"
 #include "lumar/lighting/shadows/shadow_occlusion.h"
+#include "lumar/lighting/vertex_irradiance.h"
 
 namespace lumar {
 
@@ -48,6 +49,7 @@ Compositor::Compositor(std::shared_ptr<const LoadedScene> scene, const CameraInt
       sampled_points_.back().emplace_back(mesh.positions[i]);
     spdlog::debug("object '{}': {} triangles", object.name, mesh.triangle_count());
   }
+  vertex_light_stale_.assign(s.objects.size(), 1);
   pose_object_points();
   build_shadows();
   set_features(renderer_->features());
@@ -83,7 +85,10 @@ void Compositor::set_features(const gl::CompositeFeatures& features) {
   if (features.self_occlusion) bake_self_occlusion_once();
   const gl::CompositeFeatures before = renderer_->features();
   renderer_->set_features(features);
-  if (before.self_occlusion != features.self_occlusion) give_bounce_occlusion();
+  if (before.self_occlusion != features.self_occlusion) {
+    give_bounce_occlusion();
+    std::fill(vertex_light_stale_.begin(), vertex_light_stale_.end(), 1);
+  }
   if (before.bounce != features.bounce) shadows_uploaded_ = false;
 }
 
@@ -150,6 +155,7 @@ void Compositor::set_object_pose(std::size_t index, const glm::dmat4& T_world_mo
   if (poses_.at(index) == T_world_model) return;
   poses_[index] = T_world_model;
   pose_object_points();
+  vertex_light_stale_[index] = 1;
   renderer_->set_object_pose(int(index), T_world_model);
   if (shadows_) shadows_->set_object_pose(int(index), T_world_model);
   if (object_shadows_) object_shadows_->set_object_pose(int(index), T_world_model);
@@ -164,6 +170,7 @@ void Compositor::set_lighting(const SceneLighting& lighting) {
   renderer_->set_irradiance_volume(volume_.get());
   for (std::size_t i = 0; i < scene_->objects.size(); ++i) renderer_->set_object_material(int(i), albedo_.at(i), sh_);
   light_scale_ = lighting.scale;
+  std::fill(vertex_light_stale_.begin(), vertex_light_stale_.end(), 1);
   relight_shadows();
 }
 
@@ -181,6 +188,28 @@ void Compositor::relight_shadows() {
   shadows_->relight(sample_scale);
   if (bounce_) bounce_->relight(shadows_->lines().unshadowed);
   shadows_uploaded_ = false;
+}
+
+void Compositor::set_object_shading(ObjectShading shading) {
+  if (shading == shading_) return;
+  shading_ = shading;
+  if (shading == ObjectShading::PerPixel)
+    for (std::size_t i = 0; i < scene_->objects.size(); ++i) renderer_->set_object_vertex_irradiance(int(i), {});
+  std::fill(vertex_light_stale_.begin(), vertex_light_stale_.end(), 1);
+}
+
+// Per-vertex shading: the stale objects' light from the volume, with their self-occlusion when it is on.
+void Compositor::light_vertices() {
+  if (shading_ != ObjectShading::PerVertex || !volume_) return;
+  const bool occluded = renderer_->features().self_occlusion && !self_occlusion_.empty();
+  for (std::size_t i = 0; i < scene_->objects.size(); ++i) {
+    if (!vertex_light_stale_[i]) continue;
+    const std::span<const VertexOcclusion> occlusion =
+        occluded ? std::span<const VertexOcclusion>(self_occlusion_[i]) : std::span<const VertexOcclusion>();
+    renderer_->set_object_vertex_irradiance(
+        int(i), vertex_irradiance(scene_->objects[i].model, poses_[i], occlusion, *volume_));
+    vertex_light_stale_[i] = 0;
+  }
 }
 
 void Compositor::set_object_bounce(std::size_t index, bool on) {
@@ -242,9 +271,12 @@ cv::Mat Compositor::composite(const cv::Mat& video_bgr8, const std::optional<Pos
       renderer_->set_object_light_attenuation(int(i), object_shadows_->vertex_attenuation(int(i)));
     object_shadows_uploaded_ = true;
   }
+  const auto t1 = std::chrono::steady_clock::now();
+  light_vertices();
   if (timings) {
     *timings = {};
-    timings->shadows_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    timings->shadows_ms = std::chrono::duration<double, std::milli>(t1 - t0).count();
+    timings->vertex_light_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t1).count();
   }
   return renderer_->render_overlay(video_bgr8, T_world_camera, exposure, timings);
 }

@@ -60,6 +60,10 @@ void GpuMesh::set_bounce_light(std::span<const glm::vec3> irradiance) {
   update_attribute(bounce_, 4, 3, irradiance.data(), irradiance.size(), "bounce light");
 }
 
+void GpuMesh::set_vertex_irradiance(std::span<const glm::vec3> irradiance) {
+  update_attribute(irradiance_, 5, 3, irradiance.data(), irradiance.size(), "vertex irradiance");
+}
+
 void GpuMesh::draw() const {
   if (empty()) return;
   glBindVertexArray(vertex_array_.get());

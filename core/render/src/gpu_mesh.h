@@ -1,8 +1,8 @@
 #pragma once
 // A Mesh in GPU buffers: positions at attribute 0, normals (if any) at attribute 1, and
 // optionally per-vertex values that change: a vec3 at attribute 2 (set_light_attenuation),
-// a vec4 at attribute 3 (set_self_occlusion) and a vec3 at attribute 4 (set_bounce_light).
-// Unset, attributes 3 and 4 read (0, 0, 0, 1).
+// a vec4 at attribute 3 (set_self_occlusion), a vec3 at attribute 4 (set_bounce_light) and
+// a vec3 at attribute 5 (set_vertex_irradiance). Unset, attributes 3 to 5 read (0, 0, 0, 1).
 #include <glm/glm.hpp>
 #include <span>
 
@@ -27,12 +27,14 @@ class GpuMesh {
   void set_self_occlusion(std::span<const glm::vec4> occlusion);
   // Per-vertex irradiance the other objects reflect onto it (attribute 4). Same rules.
   void set_bounce_light(std::span<const glm::vec3> irradiance);
+  // Per-vertex irradiance that shades it instead of the per-pixel volume (attribute 5). Same rules.
+  void set_vertex_irradiance(std::span<const glm::vec3> irradiance);
   void draw() const;  // binds its vertex array and draws the triangles
 
  private:
   void update_attribute(GlName& buffer, GLuint attribute, int components, const void* data, std::size_t count,
                         const char* what);
-  GlName vertex_array_, positions_, normals_, indices_, attenuation_, occlusion_, bounce_;
+  GlName vertex_array_, positions_, normals_, indices_, attenuation_, occlusion_, bounce_, irradiance_;
   GLsizei index_count_ = 0;
   std::size_t vertex_count_ = 0;
 };

@@ -124,6 +124,7 @@ struct Renderer::Impl {
     glm::vec3 albedo{0.8f};
     std::array<glm::vec3, 9> sh{};
     glm::vec3 lo{0.0f}, hi{0.0f};  // model-space bounds
+    bool vertex_lit = false;       // shaded by its per-vertex irradiance (set_object_vertex_irradiance)
   };
 
   // The pixels the objects may cover (their boxes projected, 2 px more), clipped to the
@@ -217,6 +218,7 @@ struct Renderer::Impl {
       if (shaded) {
         glProgramUniform3fv(program, uniform(program, "albedo"), 1, glm::value_ptr(o.albedo));
         glProgramUniform3fv(program, uniform(program, "sh"), 9, glm::value_ptr(o.sh[0]));
+        glProgramUniform1i(program, uniform(program, "use_vertex_irradiance"), o.vertex_lit ? 1 : 0);
       }
       o.mesh.draw();
     }
@@ -416,6 +418,13 @@ void Renderer::set_object_bounce_light(int id, std::span<const glm::vec3> irradi
   check_gl_errors("Renderer::set_object_bounce_light");
 }
 
+void Renderer::set_object_vertex_irradiance(int id, std::span<const glm::vec3> irradiance) {
+  Impl::Object& o = impl_->object(id, "set_object_vertex_irradiance");
+  if (!irradiance.empty()) o.mesh.set_vertex_irradiance(irradiance);
+  o.vertex_lit = !irradiance.empty();
+  check_gl_errors("Renderer::set_object_vertex_irradiance");
+}
+
 void Renderer::set_object_self_occlusion(int id, std::span<const VertexOcclusion> occlusion) {
   std::vector<glm::vec4> packed(occlusion.size());
   for (std::size_t i = 0; i < occlusion.size(); ++i) packed[i] = glm::vec4(occlusion[i].bent_normal, occlusion[i].open);
@@ -525,7 +534,10 @@ cv::Mat Renderer::render_overlay(const cv::Mat& video_bgr8, const std::optional<
     throw InputError("Renderer::render_overlay: video frame must be non-empty BGR8 (CV_8UC3); convert it first");
   Impl& r = *impl_;
   OverlayTimings t;
-  if (timings) t.shadows_ms = timings->shadows_ms;  // the compositor's, before this call
+  if (timings) {  // the compositor's, before this call
+    t.shadows_ms = timings->shadows_ms;
+    t.vertex_light_ms = timings->vertex_light_ms;
+  }
   StageClock clock(timings != nullptr);
 
   r.upload_video(video_bgr8);

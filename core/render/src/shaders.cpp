@@ -18,6 +18,7 @@ layout(location = 1) in vec3 normal;
 layout(location = 2) in vec3 light_attenuation;  // objects: what other objects take of the light
 layout(location = 3) in vec4 occlusion;          // objects: bent normal (model space), open share
 layout(location = 4) in vec3 bounce_light;       // objects: irradiance the other objects reflect onto it
+layout(location = 5) in vec3 vertex_irradiance;  // objects shaded per vertex: E(bent normal) x open share
 uniform mat4 model;
 uniform mat3 normal_matrix;
 uniform mat4 view_projection;
@@ -26,6 +27,7 @@ out vec3 world_normal;
 out vec3 attenuation;
 out vec4 self_occlusion;
 out vec3 bounce;
+out vec3 lit;
 // The objects' depth pre-pass and their shaded pass must agree to the bit (GL_LEQUAL).
 invariant gl_Position;
 void main() {
@@ -35,6 +37,7 @@ void main() {
   attenuation = light_attenuation;
   self_occlusion = vec4(normal_matrix * occlusion.xyz, occlusion.w);
   bounce = bounce_light;
+  lit = vertex_irradiance;
   gl_Position = view_projection * w;
 }
 )glsl";
@@ -89,11 +92,13 @@ in vec3 world_normal;
 in vec3 attenuation;
 in vec4 self_occlusion;  // bent normal (world; zero when not baked), open share
 in vec3 bounce;          // irradiance the other objects reflect onto this point
+in vec3 lit;             // the object's light per vertex (lighting/vertex_irradiance.h)
 uniform vec3 albedo;
 uniform float exposure;
 uniform vec3 sh[9];  // L00, L1-1, L10, L11, L2-2, L2-1, L20, L21, L22 (world frame)
 uniform bool use_volume;  // irradiance volume (gl/irradiance_textures.cpp) instead of sh
 uniform bool use_self_occlusion;
+uniform bool use_vertex_irradiance;  // `lit` already holds the volume's light and the self-occlusion
 vec3 volume_irradiance(vec3 p, vec3 n);
 vec3 sh9_irradiance(vec3 L0, vec3 L1, vec3 L2, vec3 L3, vec3 L4, vec3 L5, vec3 L6, vec3 L7, vec3 L8, vec3 n);
 out vec4 color;
@@ -101,17 +106,21 @@ out vec4 color;
 vec3 sh_irradiance(vec3 n) { return sh9_irradiance(sh[0], sh[1], sh[2], sh[3], sh[4], sh[5], sh[6], sh[7], sh[8], n); }
 
 void main() {
-  vec3 n = normalize(world_normal);
-  // The object's own occlusion: the light of the open directions, E(bent normal), times
-  // the open share (lighting/self_occlusion.h).
-  float open = 1.0;
-  if (use_self_occlusion && dot(self_occlusion.xyz, self_occlusion.xyz) > 1e-12) {
-    n = normalize(self_occlusion.xyz);
-    open = clamp(self_occlusion.w, 0.0, 1.0);
+  vec3 irradiance = lit;
+  if (!use_vertex_irradiance) {
+    vec3 n = normalize(world_normal);
+    // The object's own occlusion: the light of the open directions, E(bent normal), times
+    // the open share (lighting/self_occlusion.h).
+    float open = 1.0;
+    if (use_self_occlusion && dot(self_occlusion.xyz, self_occlusion.xyz) > 1e-12) {
+      n = normalize(self_occlusion.xyz);
+      open = clamp(self_occlusion.w, 0.0, 1.0);
+    }
+    // Nine coefficients can ring below zero opposite a bright source; light is never negative.
+    irradiance = use_volume ? volume_irradiance(world_position, n) : max(sh_irradiance(n), vec3(0.0));
+    irradiance *= open;
   }
-  // Nine coefficients can ring below zero opposite a bright source; light is never negative.
-  vec3 irradiance = use_volume ? volume_irradiance(world_position, n) : max(sh_irradiance(n), vec3(0.0));
-  irradiance *= clamp(attenuation, 0.0, 1.0) * open;
+  irradiance *= clamp(attenuation, 0.0, 1.0);
   irradiance += max(bounce, vec3(0.0));
   color = vec4(albedo * irradiance * (exposure / 3.14159265358979), 1.0);
 }

@@ -131,7 +131,10 @@ Mesh transformed(const Mesh& mesh, const glm::dmat4& m) {
     out.positions.emplace_back(glm::dvec3(q) / q.w);
   }
   const glm::dmat3 normal_matrix = glm::transpose(glm::inverse(glm::dmat3(m)));
-  for (const auto& n : mesh.normals) out.normals.emplace_back(glm::normalize(normal_matrix * glm::dvec3(n)));
+  for (const auto& n : mesh.normals) {
+    const glm::dvec3 t = normal_matrix * glm::dvec3(n);
+    out.normals.emplace_back(glm::length(t) > 0.0 ? glm::normalize(t) : t);  // a missing normal stays zero
+  }
   out.indices = mesh.indices;
   // A mirroring transform turns counter-clockwise triangles clockwise; swap two corners
   // so that the winding still agrees with the (correctly transformed) normals.

@@ -10,6 +10,7 @@
 #include "lumar/base/constants.h"
 #include "lumar/base/error.h"
 #include "lumar/lighting/irradiance_volume.h"
+#include "lumar/scene/mesh.h"
 
 namespace lumar {
 
@@ -289,17 +290,10 @@ bool ObjectBounce::update(const Irradiance& irradiance) {
     Object& to = objects_[b];
     std::fill(to.received.begin(), to.received.end(), glm::vec3(0.0f));
     if (objects_.size() < 2) continue;
-    const glm::mat4 T(to.T_world_model);
-    const glm::mat3 normal_matrix = glm::transpose(glm::inverse(glm::mat3(T)));
-    std::vector<glm::vec3> positions(to.model.positions.size()), normals(positions.size());
-    for (std::size_t v = 0; v < positions.size(); ++v) {
-      positions[v] = glm::vec3(T * glm::vec4(to.model.positions[v], 1.0f));
-      const glm::vec3 n = normal_matrix * to.model.normals[v];
-      normals[v] = glm::length(n) > 0 ? glm::normalize(n) : n;
-    }
+    const Mesh posed = transformed(to.model, to.T_world_model);
     for (std::size_t a = 0; a < objects_.size(); ++a)
       if (a != b && objects_[a].enabled && !objects_[a].surface.clusters.empty())
-        add_object_bounce(objects_[a], irradiance, positions, normals, to.received);
+        add_object_bounce(objects_[a], irradiance, posed.positions, posed.normals, to.received);
   }
   stats_.onto_objects_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t1).count();
   for (std::size_t i = 0; i < positions_.size(); ++i) {

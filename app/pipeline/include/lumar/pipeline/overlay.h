@@ -39,14 +39,15 @@ struct OverlaySettings {
   // calib/camera_blur.h) unless blur_sigma_px >= 0 gives the blur.
   gl::CompositeFeatures features;
   double blur_sigma_px = -1.0;
+  ObjectShading shading = ObjectShading::PerPixel;  // the volume's light per pixel or per vertex
   // Animated objects (the manifest's paths) play in recording time; live, from the first
   // frame the overlay sees.
   bool live = false;
 };
 
 struct StageTimes {  // milliseconds, summed over frames
-  double decode = 0, pose = 0, measure = 0, lighting = 0, shadows = 0, upload = 0, background = 0, depth = 0,
-         objects = 0, antialiasing = 0, blur = 0, readback = 0, output = 0;
+  double decode = 0, pose = 0, measure = 0, lighting = 0, shadows = 0, vertex_light = 0, upload = 0, background = 0,
+         depth = 0, objects = 0, antialiasing = 0, blur = 0, readback = 0, output = 0;
   // From a frame's start (replay: its decode; live: the middle of its exposure) to its
   // composite handed on, summed over frames.
   double latency = 0;

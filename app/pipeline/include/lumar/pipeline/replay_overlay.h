@@ -38,7 +38,14 @@ class ReplayOverlay {
 
   // Runs every frame (up to max_frames, 0 = all) through the overlay; `sink` sees each
   // result and returns false to stop early (e.g. the window was closed).
-  void run(int max_frames, const std::function<bool(const OverlayFrame&)>& sink);
+  // Pipelined: decoding, then the pose and the composite (this thread, which holds the GL
+  // context), then the sink each run on their own thread, handing frames on through
+  // queues kPipelineDepth deep, so the throughput is the slowest stage's. The sink then
+  // runs off this thread and must not touch the overlay; it still sees the frames in
+  // order, and a false from it stops the run within kPipelineDepth frames. Serial: one
+  // stage after another on this thread (the baseline, and what a window needs).
+  static constexpr int kPipelineDepth = 1;
+  void run(int max_frames, const std::function<bool(const OverlayFrame&)>& sink, bool pipelined = false);
 
   // The camera's pose for a frame of this recording, from the settings' source (nullopt:
   // the tracker has nothing for it). Fused poses want the frames in order; any other
@@ -63,6 +70,7 @@ class ReplayOverlay {
   const LiveLighting* live_lighting() const { return overlay_->live_lighting(); }
 
  private:
+  void run_pipelined(int max_frames, const std::function<bool(const OverlayFrame&)>& sink);
   std::filesystem::path recording_;
   capture::RecordingReplay replay_;
   PoseSource pose_source_;

@@ -16,6 +16,9 @@ namespace lumar {
 VolumeSettings scene_volume_settings(const LightingSettings& lighting, const std::string& method);
 // The room's radiance: the scene's map on its proxy, or by direction alone when distant.
 std::unique_ptr<RoomRadiance> scene_radiance(const LoadedScene& scene, const RadianceSettings& settings);
+// The radiance the scene's own volume is built from: scene_radiance with the radiance
+// settings of the manifest's lighting.method.
+std::unique_ptr<RoomRadiance> scene_base_radiance(const LoadedScene& scene);
 // The scene's irradiance volume over its movement box with `method`'s settings, loaded
 // from the cache (cache_dir; empty: the default) when it holds one built from the same
 // inputs, else built (and stored, unless use_cache is false). `loaded` says which.
@@ -25,9 +28,8 @@ IrradianceVolume scene_irradiance_volume(const LoadedScene& scene, const std::st
 // The scene's lighting after the room changed (pipeline/live_lighting.h): the change
 // per map cell; the irradiance volume over the movement box rebuilt from `base` relit to
 // the scaled map, so that it has the layout of the scene's own volume and the two can be
-// blended (IrradianceVolume::blend); the scaled map's SH9. `base`: the scene's radiance,
-// scene_radiance(scene, scene_volume_settings(...).radiance). No volume when the
-// manifest's lighting.method is "sh9".
+// blended (IrradianceVolume::blend); the scaled map's SH9. `base`: scene_base_radiance(scene).
+// No volume when the manifest's lighting.method is "sh9".
 struct SceneLighting {
   MapCellScale scale;
   std::shared_ptr<const IrradianceVolume> volume;

@@ -30,6 +30,14 @@ struct ShadowQuality {
   bool operator==(const ShadowQuality&) const = default;
 };
 
+// Where the objects' light from the irradiance volume is evaluated: at every covered
+// pixel on the GPU, or on the CPU at their vertices (lighting/vertex_irradiance.h), again
+// only when an object moved or the light changed, and interpolated across the triangles.
+// Per vertex costs a dense mesh little accuracy and llvmpipe most of the objects' stage
+// (docs/irradiance.md, "Shading per vertex"). Without a volume (lighting.method "sh9")
+// both are the same.
+enum class ObjectShading { PerPixel, PerVertex };
+
 class Compositor {
  public:
   // `output_camera`: the undistorted camera the renderer draws with. `map_x`, `map_y`:
@@ -70,6 +78,8 @@ class Compositor {
   // each other, added to their shading (lighting/shadows/object_bounce.h), from objects
   // whose manifest entry allows it.
   void set_features(const gl::CompositeFeatures& features);
+  void set_object_shading(ObjectShading shading);
+  ObjectShading object_shading() const { return shading_; }
   // The shadow lines, or nullptr when the scene has no receivers.
   const LineShadows* shadows() const { return shadows_.get(); }
   // The objects' shadows on each other, or nullptr with fewer than two objects.
@@ -92,8 +102,7 @@ class Compositor {
   const SH9& lighting_sh() const { return sh_; }
   // The irradiance volume that shades the objects per pixel (built for the scene's
   // movement box, or loaded from the cache), or nullptr when lighting.method is "sh9".
-  const IrradianceVolume* irradiance_volume() const { return volume_.get(); }
-  const std::shared_ptr<const IrradianceVolume>& irradiance_volume_ptr() const { return volume_; }
+  const std::shared_ptr<const IrradianceVolume>& irradiance_volume() const { return volume_; }
   // A few hundred surface points of the virtual objects in their current poses, world
   // coordinates, for checking where they project.
   const std::vector<glm::dvec3>& object_points() const { return object_points_; }
@@ -121,6 +130,9 @@ class Compositor {
   MapCellScale light_scale_;  // the room's change since the map was captured (set_lighting)
   void relight_shadows();
   void upload_object_bounce(bool on);
+  ObjectShading shading_ = ObjectShading::PerPixel;
+  std::vector<char> vertex_light_stale_;  // per object: moved, or the light changed, since lit
+  void light_vertices();
   bool shadows_enabled_ = true, object_shadows_enabled_ = true, shadows_uploaded_ = false,
        object_shadows_uploaded_ = false;
 };

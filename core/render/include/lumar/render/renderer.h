@@ -30,7 +30,8 @@ namespace lumar::gl {
 // Wall time of each stage of render_overlay. Asking for timings makes the stages wait
 // for each other (glFinish between them), so ask only when profiling.
 struct OverlayTimings {
-  double shadows_ms = 0;  // the compositor's: moved objects' shadows traced again (shadow lines)
+  double shadows_ms = 0;       // the compositor's: moved objects' shadows traced again (shadow lines)
+  double vertex_light_ms = 0;  // the compositor's: moved objects' light per vertex (ObjectShading::PerVertex)
   double upload_ms = 0, background_ms = 0, depth_ms = 0, objects_ms = 0, antialiasing_ms = 0, blur_ms = 0,
          readback_ms = 0;
 };
@@ -88,6 +89,11 @@ class Renderer {
   // Per vertex (mesh order): the irradiance the other objects reflect onto it, added to
   // its shading (lighting/shadows/object_bounce.h). Unset: none.
   void set_object_bounce_light(int id, std::span<const glm::vec3> irradiance);
+  // Per vertex (mesh order): the object's light, E(bent normal) x open share
+  // (lighting/vertex_irradiance.h), which then shades it instead of the volume or SH9 per
+  // pixel; the other objects' shadows and bounce still apply. Empty: back to per pixel.
+  // Throws InputError unless empty or one value per vertex.
+  void set_object_vertex_irradiance(int id, std::span<const glm::vec3> irradiance);
   // Per vertex (mesh order), the object's occlusion of itself (bake_self_occlusion);
   // unset, the object is open everywhere. Throws InputError unless one value per vertex.
   void set_object_self_occlusion(int id, std::span<const VertexOcclusion> occlusion);

@@ -1,0 +1,22 @@
+#pragma once
+// An object's light per vertex: E(bent normal) x open share at each posed vertex, from
+// the irradiance volume the renderer otherwise evaluates at every pixel. The cheap end of
+// the objects' shading knob (docs/irradiance.md, "Shading per vertex"): the cost is per
+// vertex, not per covered pixel, and an object that does not move pays it once.
+#include <glm/glm.hpp>
+#include <span>
+#include <vector>
+
+#include "lumar/lighting/irradiance_volume.h"
+#include "lumar/lighting/self_occlusion.h"
+#include "lumar/scene/mesh.h"
+
+namespace lumar {
+
+// One irradiance per vertex of `model` (mesh order) posed by T_world_model. `occlusion`:
+// the object's own (bake_self_occlusion), one per vertex, or empty for open everywhere.
+// Throws InputError when `occlusion` has another length.
+std::vector<glm::vec3> vertex_irradiance(const Mesh& model, const glm::dmat4& T_world_model,
+                                         std::span<const VertexOcclusion> occlusion, const IrradianceVolume& volume);
+
+}  // namespace lumar
