@@ -25,6 +25,10 @@ void add_composite_options(CLI::App* cmd, CompositeOptions& o) {
                   "Where the objects' light from the irradiance volume is evaluated: pixel (every covered pixel) or "
                   "vertex (their vertices, again only when they move; docs/irradiance.md)")
       ->capture_default_str();
+  cmd->add_option("--shadow-lines", o.shadow_lines,
+                  "Shadow lines per receiver and emitter patch: fewer trace a moving object's shadow faster and "
+                  "coarser (docs/shadows.md)")
+      ->capture_default_str();
 }
 
 void apply_composite_options(const CompositeOptions& o, pipeline::OverlaySettings& settings) {
@@ -52,6 +56,9 @@ void apply_composite_options(const CompositeOptions& o, pipeline::OverlaySetting
   if (o.shading != "pixel" && o.shading != "vertex")
     throw InputError("--shading " + o.shading + ": use pixel or vertex");
   settings.shading = o.shading == "vertex" ? ObjectShading::PerVertex : ObjectShading::PerPixel;
+  if (o.shadow_lines < 1 || o.shadow_lines > 64)
+    throw InputError("--shadow-lines " + std::to_string(o.shadow_lines) + ": use 1 to 64 lines per patch");
+  settings.shadow_quality.lines_per_patch = o.shadow_lines;
 }
 
 void add_live_input_options(CLI::App* cmd, pipeline::LiveInputOptions& o, const std::string& camera_help) {

@@ -22,11 +22,13 @@ void add_live_input_options(
 
 // --without and --blur-sigma: what makes rendered pixels look like the camera's
 // (gl::CompositeFeatures); --shading: the objects' light per pixel or per vertex
-// (ObjectShading). The same names in every command that composites.
+// (ObjectShading); --shadow-lines: lines per receiver and emitter patch (ShadowQuality).
+// The same names in every command that composites.
 struct CompositeOptions {
   std::string without;
   double blur_sigma_px = -1.0;
   std::string shading = "pixel";
+  int shadow_lines = ShadowQuality{}.lines_per_patch;
 };
 void add_composite_options(CLI::App* cmd, CompositeOptions& o);
 // Applies them to `settings`; InputError names an unknown feature.

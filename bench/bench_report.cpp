@@ -51,7 +51,11 @@ std::string short_number(double v) { return fmt::format("{:.3g}", v); }
 void BenchReport::write_chart(const std::filesystem::path& file) const {
   const bool tradeoff = std::any_of(entries.begin(), entries.end(), [](const auto& e) { return !std::isnan(e.error); });
   const bool xy = std::any_of(entries.begin(), entries.end(), [](const auto& e) { return !std::isnan(e.x); });
-  const int W = 900, H = tradeoff ? 560 : 120 + 34 * int(entries.size());
+  // Bars start right of the longest name (at least 260 pixels in).
+  int label_width = 240;
+  for (const auto& e : entries)
+    label_width = std::max(label_width, cv::getTextSize(e.name, cv::FONT_HERSHEY_SIMPLEX, 0.45, 1, nullptr).width);
+  const int W = 660 + label_width, H = tradeoff ? 560 : 120 + 34 * int(entries.size());
   cv::Mat img(H, W, CV_8UC3, cv::Scalar(255, 255, 255));
   text(img, title, {20, 30}, 0.6);
   if (xy) {
@@ -108,7 +112,7 @@ void BenchReport::write_chart(const std::filesystem::path& file) const {
     }
   } else if (!tradeoff) {
     // Horizontal bars: one per entry, time in ms, ratio to the baseline after it.
-    const int left = 260, right = W - 170, top = 60;
+    const int left = label_width + 20 + 16, right = W - 170, top = 60;
     double tmax = 0;
     for (const auto& e : entries) tmax = std::max(tmax, e.time_ms);
     for (std::size_t i = 0; i < entries.size(); ++i) {

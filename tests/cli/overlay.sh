@@ -130,6 +130,8 @@ assert s['frames'] == 4, s['frames']
 assert s['stages']['object light per vertex'] > 0, s['stages']
 PY
   expect_bad_input "--shading" "$TMP/bad" -- "$LUMAR" overlay --recording "$REC" --shading facet --frames-dir "$TMP/bad"
+  expect_bad_input "--shadow-lines" "$TMP/bad" -- "$LUMAR" overlay --recording "$REC" --shadow-lines 0 \
+    --frames-dir "$TMP/bad"
 }
 
 case_window_without_display_fails_cleanly() {

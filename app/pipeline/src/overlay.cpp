@@ -69,6 +69,7 @@ Overlay::Overlay(std::shared_ptr<const LoadedScene> scene, const CameraIntrinsic
   if (settings.blur_sigma_px >= 0) radiometry_.blur_sigma_px = settings.blur_sigma_px, blur_known_ = true;
   compositor_->set_features(settings.features);
   compositor_->set_object_shading(settings.shading);
+  compositor_->set_shadow_quality(settings.shadow_quality);
   compositor_->renderer().set_video_radiometry(radiometry_);
   lighting_cells_ = settings.adapt_lighting_cells;
   set_adapt_lighting_every(settings.adapt_lighting_every);
@@ -128,10 +129,12 @@ void Overlay::set_scene(std::shared_ptr<const LoadedScene> scene) {
   live_lighting_.reset();
   const gl::CompositeFeatures features = compositor_->renderer().features();
   const ObjectShading shading = compositor_->object_shading();
+  const ShadowQuality shadow_quality = compositor_->shadow_quality();
   compositor_.reset();  // its GL objects go first
   compositor_ = std::make_unique<Compositor>(std::move(scene), maps_.output, maps_.map_x, maps_.map_y, volume_cache_);
   compositor_->set_features(features);
   compositor_->set_object_shading(shading);
+  compositor_->set_shadow_quality(shadow_quality);
   compositor_->renderer().set_video_radiometry(radiometry_);
   set_adapt_lighting_every(lighting_every_);
   frames_since_clip_check_ = kClipCheckEvery, clip_warned_ = false;  // other objects may clip

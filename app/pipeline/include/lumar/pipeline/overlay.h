@@ -40,6 +40,7 @@ struct OverlaySettings {
   gl::CompositeFeatures features;
   double blur_sigma_px = -1.0;
   ObjectShading shading = ObjectShading::PerPixel;  // the volume's light per pixel or per vertex
+  ShadowQuality shadow_quality;                     // lines per receiver and emitter patch (docs/shadows.md)
   // Animated objects (the manifest's paths) play in recording time; live, from the first
   // frame the overlay sees.
   bool live = false;
