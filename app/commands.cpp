@@ -29,6 +29,9 @@ void add_composite_options(CLI::App* cmd, CompositeOptions& o) {
                   "Shadow lines per receiver and emitter patch: fewer trace a moving object's shadow faster and "
                   "coarser (docs/shadows.md)")
       ->capture_default_str();
+  cmd->add_option("--exact-lights", o.exact_lights,
+                  "The irradiance volume's exact lights, evaluated with shadow maps (0 to 16; default: the manifest's "
+                  "lighting.irradiance.max_lights, else 16; docs/irradiance.md)");
 }
 
 void apply_composite_options(const CompositeOptions& o, pipeline::OverlaySettings& settings) {
@@ -59,6 +62,11 @@ void apply_composite_options(const CompositeOptions& o, pipeline::OverlaySetting
   if (o.shadow_lines < 1 || o.shadow_lines > 64)
     throw InputError("--shadow-lines " + std::to_string(o.shadow_lines) + ": use 1 to 64 lines per patch");
   settings.shadow_quality.lines_per_patch = o.shadow_lines;
+  if (o.exact_lights != -1) {
+    if (o.exact_lights < 0 || o.exact_lights > 16)
+      throw InputError("--exact-lights " + std::to_string(o.exact_lights) + ": use 0 to 16");
+    settings.exact_lights = o.exact_lights;
+  }
 }
 
 void add_live_input_options(CLI::App* cmd, pipeline::LiveInputOptions& o, const std::string& camera_help) {

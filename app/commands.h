@@ -22,13 +22,15 @@ void add_live_input_options(
 
 // --without and --blur-sigma: what makes rendered pixels look like the camera's
 // (gl::CompositeFeatures); --shading: the objects' light per pixel or per vertex
-// (ObjectShading); --shadow-lines: lines per receiver and emitter patch (ShadowQuality).
+// (ObjectShading); --shadow-lines: lines per receiver and emitter patch (ShadowQuality);
+// --exact-lights: the volume's lights evaluated with shadow maps.
 // The same names in every command that composites.
 struct CompositeOptions {
   std::string without;
   double blur_sigma_px = -1.0;
   std::string shading = "pixel";
   int shadow_lines = ShadowQuality{}.lines_per_patch;
+  int exact_lights = -1;  // -1: the manifest's
 };
 void add_composite_options(CLI::App* cmd, CompositeOptions& o);
 // Applies them to `settings`; InputError names an unknown feature.

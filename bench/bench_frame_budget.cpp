@@ -1,7 +1,7 @@
 // The quality knobs of the overlay against its composite error and time per frame
 // (issue 19): where the objects are lit (per pixel or per vertex, ObjectShading), the
 // shadow lines per receiver and emitter patch (ShadowQuality), and the number of exact
-// lights the volume evaluates with shadow maps (lighting.irradiance.max_lights). On a
+// lights the volume evaluates with shadow maps (OverlaySettings::exact_lights). On a
 // synthetic recording of the walk scene with its truth (the figurine moves, so its shadow
 // and its light are traced again every frame), through the pipeline library `lumar
 // regress` runs. Baseline: full quality (per pixel, 8 lines, 16 lights) in the same run.
@@ -10,11 +10,7 @@
 #include <spdlog/spdlog.h>
 #include <unistd.h>
 
-#include <fstream>
-#include <nlohmann/json.hpp>
-
 #include "bench_report.h"
-#include "lumar/base/output_file.h"
 #include "lumar/calib/camera_file.h"
 #include "lumar/pipeline/truth_comparison.h"
 #include "lumar/sim/synthetic_recording.h"
@@ -34,23 +30,6 @@ struct Knobs {
     return fmt::format("{}, {} lines, {} lights", vertex ? "vertex" : "pixel", lines, lights);
   }
 };
-
-// The walk's manifest with another light count, its file paths made absolute so that it
-// may live in `dir`.
-fs::path manifest_with_lights(int lights, const fs::path& dir) {
-  nlohmann::json j = nlohmann::json::parse(std::ifstream(kScene));
-  const fs::path base = kScene.parent_path();
-  const auto absolute = [&](nlohmann::json& path) {
-    path = fs::weakly_canonical(base / path.get<std::string>()).string();
-  };
-  absolute(j["room"]["mesh"]);
-  absolute(j["environment_map"]["path"]);
-  for (auto& o : j["objects"]) absolute(o["mesh"]);
-  j["lighting"]["irradiance"]["max_lights"] = lights;
-  const fs::path out = dir / fmt::format("walk-{}-lights.json", lights);
-  write_file_atomically(out, j.dump(2));
-  return out;
-}
 
 }  // namespace
 
@@ -75,7 +54,7 @@ int main() {
   std::vector<double> ms;
   for (const Knobs& knobs : settings) {
     pipeline::ReplayOverlaySettings s;
-    s.scene = knobs.lights == 16 ? fs::path() : manifest_with_lights(knobs.lights, out);
+    s.overlay.exact_lights = knobs.lights;
     s.overlay.shading = knobs.vertex ? ObjectShading::PerVertex : ObjectShading::PerPixel;
     s.overlay.shadow_quality.lines_per_patch = knobs.lines;
     const auto compared = pipeline::compare_with_truth(synth.out, s);

@@ -132,6 +132,8 @@ PY
   expect_bad_input "--shading" "$TMP/bad" -- "$LUMAR" overlay --recording "$REC" --shading facet --frames-dir "$TMP/bad"
   expect_bad_input "--shadow-lines" "$TMP/bad" -- "$LUMAR" overlay --recording "$REC" --shadow-lines 0 \
     --frames-dir "$TMP/bad"
+  expect_bad_input "--exact-lights" "$TMP/bad" -- "$LUMAR" overlay --recording "$REC" --exact-lights 17 \
+    --frames-dir "$TMP/bad"
 }
 
 case_window_without_display_fails_cleanly() {

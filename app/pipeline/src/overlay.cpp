@@ -35,6 +35,18 @@ gl::VideoRadiometry renderer_radiometry(const capture::Radiometry& radiometry, c
 
 }  // namespace
 
+namespace {
+// The scene with the exact-light count the settings ask for (a copy only when it differs).
+std::shared_ptr<const LoadedScene> with_exact_lights(std::shared_ptr<const LoadedScene> scene,
+                                                     const std::optional<int>& lights) {
+  if (!lights || scene->manifest.lighting.max_lights == lights) return scene;
+  if (*lights < 0 || *lights > 16) throw InputError("exact lights: " + std::to_string(*lights) + "; use 0 to 16");
+  auto copy = std::make_shared<LoadedScene>(*scene);
+  copy->manifest.lighting.max_lights = *lights;
+  return copy;
+}
+}  // namespace
+
 Overlay::Overlay(std::shared_ptr<const LoadedScene> scene, const CameraIntrinsics& camera,
                  const capture::Radiometry& radiometry, const std::optional<calib::CameraResponse>& response,
                  const OverlaySettings& settings)
@@ -42,7 +54,8 @@ Overlay::Overlay(std::shared_ptr<const LoadedScene> scene, const CameraIntrinsic
       camera_(camera),
       session_radiometry_(radiometry),
       live_(settings.live),
-      volume_cache_(settings.volume_cache) {
+      volume_cache_(settings.volume_cache),
+      exact_lights_(settings.exact_lights) {
   if (settings.window) {
     const char* display = std::getenv("DISPLAY");
     if (!display || !*display)
@@ -59,8 +72,8 @@ Overlay::Overlay(std::shared_ptr<const LoadedScene> scene, const CameraIntrinsic
   }
   maps_ = calib::make_undistortion_maps(camera, settings.undistortion);
   const calib::UndistortionMaps& maps = maps_;
-  compositor_ =
-      std::make_unique<Compositor>(std::move(scene), maps.output, maps.map_x, maps.map_y, settings.volume_cache);
+  compositor_ = std::make_unique<Compositor>(with_exact_lights(std::move(scene), exact_lights_), maps.output,
+                                             maps.map_x, maps.map_y, settings.volume_cache);
   // The renderer's linear unit is the response's (sRGB with gain 1 without one).
   response_ = response.value_or(calib::srgb_response(1.0));
   radiometry_ = renderer_radiometry(radiometry, camera, response);
@@ -131,7 +144,8 @@ void Overlay::set_scene(std::shared_ptr<const LoadedScene> scene) {
   const ObjectShading shading = compositor_->object_shading();
   const ShadowQuality shadow_quality = compositor_->shadow_quality();
   compositor_.reset();  // its GL objects go first
-  compositor_ = std::make_unique<Compositor>(std::move(scene), maps_.output, maps_.map_x, maps_.map_y, volume_cache_);
+  compositor_ = std::make_unique<Compositor>(with_exact_lights(std::move(scene), exact_lights_), maps_.output,
+                                             maps_.map_x, maps_.map_y, volume_cache_);
   compositor_->set_features(features);
   compositor_->set_object_shading(shading);
   compositor_->set_shadow_quality(shadow_quality);

@@ -41,6 +41,10 @@ struct OverlaySettings {
   double blur_sigma_px = -1.0;
   ObjectShading shading = ObjectShading::PerPixel;  // the volume's light per pixel or per vertex
   ShadowQuality shadow_quality;                     // lines per receiver and emitter patch (docs/shadows.md)
+  // The exact lights the irradiance volume evaluates with shadow maps, instead of the
+  // manifest's lighting.irradiance.max_lights (0 to 16; the volume is built, or taken
+  // from the cache, for that count).
+  std::optional<int> exact_lights;
   // Animated objects (the manifest's paths) play in recording time; live, from the first
   // frame the overlay sees.
   bool live = false;
@@ -143,6 +147,7 @@ class Overlay {
   bool noise_known_ = false, blur_known_ = false, warned_ = false;
   std::int64_t frames_seen_ = 0;
   bool live_ = false, volume_cache_ = true;
+  std::optional<int> exact_lights_;
   std::optional<Nanos> first_frame_time_;
   StageTimes times_;
   std::optional<std::chrono::steady_clock::time_point> first_composite_;
