@@ -32,8 +32,7 @@ pipeline::ReplayOverlaySettings with_features(bool on) {
 }
 
 struct Fixture {
-  explicit Fixture(bool features = true, const std::filesystem::path& recording = kRecording)
-      : overlay(recording, with_features(features)) {}
+  explicit Fixture(bool features = true) : overlay(kRecording, with_features(features)) {}
   pipeline::ReplayOverlay overlay;
   std::unique_ptr<capture::FrameSource> frames = overlay.replay().open_frames();
   capture::Frame frame;
@@ -50,11 +49,6 @@ struct Fixture {
 
 Fixture& fixture() {
   static Fixture f;
-  return f;
-}
-
-Fixture& walk_fixture() {
-  static Fixture f(true, kWalk);
   return f;
 }
 
@@ -87,18 +81,6 @@ void composite_frame(benchmark::State& state, bool features) {
   state.counters["readback_ms"] = C(after.readback - before.readback, C::kAvgIterations);
 }
 
-// The whole recording as `lumar overlay` replays it (decode, pose, composite), without
-// writing outputs; one iteration is one pass (main divides by the frames).
-void replay_frame(benchmark::State& state, bool walk) {
-  auto& f = walk ? walk_fixture() : fixture();
-  for (auto _ : state) {
-    f.overlay.run(0, [&](const pipeline::OverlayFrame& out) {
-      benchmark::DoNotOptimize(out.composite.data);
-      return true;
-    });
-  }
-}
-
 // How one replay is run: which recording, shading and threads, and whether H.264 is written.
 struct Throughput {
   bool walk = false, vertex = false, pipelined = false, encode = false;
@@ -109,27 +91,33 @@ struct Throughput {
   std::string name() const { return std::string(walk ? "walk, " : "orbit, ") + label(); }
 };
 
-// Frames per second and latency over whole replays, through the pipeline library. One
-// overlay per recording and shading, made (and its shaders compiled) before the clock runs.
-void replay_throughput(benchmark::State& state, Throughput t) {
+// One overlay per recording and shading, made (and its shaders compiled) before a clock
+// runs; its stage times add up over every replay of it.
+pipeline::ReplayOverlay& throughput_overlay(bool walk, bool vertex) {
   static std::map<std::pair<bool, bool>, std::unique_ptr<pipeline::ReplayOverlay>> overlays;
-  auto& overlay = overlays[{t.walk, t.vertex}];
+  auto& overlay = overlays[{walk, vertex}];
   if (!overlay) {
     pipeline::ReplayOverlaySettings s;
-    s.overlay.shading = t.vertex ? ObjectShading::PerVertex : ObjectShading::PerPixel;
-    overlay = std::make_unique<pipeline::ReplayOverlay>(t.walk ? kWalk : kRecording, s);
+    s.overlay.shading = vertex ? ObjectShading::PerVertex : ObjectShading::PerPixel;
+    overlay = std::make_unique<pipeline::ReplayOverlay>(walk ? kWalk : kRecording, s);
     overlay->run(2, [](const pipeline::OverlayFrame&) { return true; });
   }
-  const auto& camera = overlay->compositor().output_camera();
+  return *overlay;
+}
+
+// Frames per second and latency over whole replays, through the pipeline library.
+void replay_throughput(benchmark::State& state, Throughput t) {
+  pipeline::ReplayOverlay& overlay = throughput_overlay(t.walk, t.vertex);
+  const auto& camera = overlay.compositor().output_camera();
   const std::string video =
       (std::filesystem::temp_directory_path() / ("lumar-bench-" + std::to_string(::getpid()) + ".mp4")).string();
-  const pipeline::StageTimes before = overlay->times();
+  const pipeline::StageTimes before = overlay.times();
   for (auto _ : state) {
     std::optional<pipeline::OverlayOutputs> outputs;
     if (t.encode)
-      outputs.emplace(pipeline::OverlayOutputSettings{video, "", "", overlay->replay().reader().video().fps,
+      outputs.emplace(pipeline::OverlayOutputSettings{video, "", "", overlay.replay().reader().video().fps,
                                                       cv::Size(camera.width, camera.height)});
-    overlay->run(
+    overlay.run(
         0,
         [&](const pipeline::OverlayFrame& f) {
           if (outputs) outputs->write(f.index, f.composite);
@@ -140,7 +128,7 @@ void replay_throughput(benchmark::State& state, Throughput t) {
     if (outputs) outputs->commit();
   }
   std::filesystem::remove(video);
-  const pipeline::StageTimes& after = overlay->times();
+  const pipeline::StageTimes& after = overlay.times();
   const double frames = after.frames - before.frames;
   using C = benchmark::Counter;
   state.counters["frames"] = C(frames, C::kAvgIterations);  // per pass
@@ -162,14 +150,6 @@ int main(int argc, char** argv) {
       ->Unit(benchmark::kMillisecond)
       ->MinTime(2.0)
       ->UseRealTime();
-  benchmark::RegisterBenchmark("replay_frame", replay_frame, false)
-      ->Unit(benchmark::kMillisecond)
-      ->Iterations(2)
-      ->UseRealTime();
-  benchmark::RegisterBenchmark("replay_walk_frame", replay_frame, true)
-      ->Unit(benchmark::kMillisecond)
-      ->Iterations(2)
-      ->UseRealTime();
   std::vector<Throughput> throughputs;
   for (bool walk : {false, true})
     for (const Throughput& t : {Throughput{walk, false, false, false}, Throughput{walk, true, false, false},
@@ -187,13 +167,18 @@ int main(int argc, char** argv) {
 
   const auto* decode = reporter.find("decode_frame");
   const auto* composite = reporter.find("composite_frame");
-  const auto* replay = reporter.find("replay_frame");
   const auto* plain = reporter.find("composite_frame_features_off");
-  const auto* walk = reporter.find("replay_walk_frame");
-  if (!decode || !composite || !replay || !plain || !walk) return 0;  // a filtered run: no report
+  if (!decode || !composite || !plain) return 0;  // a filtered run: no report
+  // A replay's time per frame (nullopt: not run).
+  const auto ms_per_frame = [&](const Throughput& t) -> std::optional<double> {
+    const auto* r = reporter.find("throughput/" + t.name());
+    if (!r) return std::nullopt;
+    return r->time_ms / std::max(1.0, r->counters.at("frames"));
+  };
+  const auto replay = ms_per_frame(Throughput{}), walk = ms_per_frame(Throughput{.walk = true});
+  if (!replay || !walk) return 0;
+  const double replay_ms = *replay, walk_ms = *walk;
   const auto& c = composite->counters;
-  const int frames_per_pass = int(fixture().overlay.replay().reader().frames().size());
-  const double replay_ms = replay->time_ms / std::max(1, frames_per_pass);
   bench::BenchReport report;
   report.name = "overlay_stages";
   report.title = "Overlay at 640x480, sample recording, Mesa llvmpipe: time per stage";
@@ -209,11 +194,9 @@ int main(int argc, char** argv) {
                     {"composite, all stages", composite->time_ms},
                     {"composite, features off", plain->time_ms},
                     {"replay: decode+pose+composite", replay_ms}};
-  // The walk: per stage, over its replays (the overlay's own stage clock).
-  const pipeline::StageTimes& w = walk_fixture().overlay.times();
+  // The walk shaded per pixel: per stage, over its replays (the overlay's own stage clock).
+  const pipeline::StageTimes& w = throughput_overlay(true, false).times();
   const double walk_frames = std::max(1, w.frames);
-  const double walk_ms =
-      walk->time_ms / std::max<std::size_t>(1, walk_fixture().overlay.replay().reader().frames().size());
   for (const auto& [name, ms] : std::initializer_list<std::pair<const char*, double>>{
            {"walk: decode video", w.decode},
            {"walk: shadows (moved objects)", w.shadows},
@@ -232,12 +215,11 @@ int main(int argc, char** argv) {
                   ", Mesa llvmpipe: ms per frame";
     for (const Throughput& t : throughputs) {
       if (t.walk != walk) continue;
-      const auto* r = reporter.find("throughput/" + t.name());
-      if (!r) return 0;
-      const double ms = r->time_ms / std::max(1.0, r->counters.at("frames"));
-      table.entries.push_back({t.label(), ms});
-      std::printf("%-40s %6.2f ms per frame  %5.1f frames/s  latency %6.1f ms\n", t.name().c_str(), ms, 1000.0 / ms,
-                  r->counters.at("latency_ms"));
+      const auto ms = ms_per_frame(t);
+      if (!ms) return 0;
+      table.entries.push_back({t.label(), *ms});
+      std::printf("%-40s %6.2f ms per frame  %5.1f frames/s  latency %6.1f ms\n", t.name().c_str(), *ms, 1000.0 / *ms,
+                  reporter.find("throughput/" + t.name())->counters.at("latency_ms"));
     }
     table.baseline = table.entries.front().name;
     table.compute_ratios();

@@ -33,9 +33,6 @@ gl::VideoRadiometry renderer_radiometry(const capture::Radiometry& radiometry, c
   return out;
 }
 
-}  // namespace
-
-namespace {
 // The scene with the exact-light count the settings ask for (a copy only when it differs).
 std::shared_ptr<const LoadedScene> with_exact_lights(std::shared_ptr<const LoadedScene> scene,
                                                      const std::optional<int>& lights) {

@@ -12,9 +12,19 @@
 namespace lumar::pipeline {
 
 namespace {
-double ms_since(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-}
+using Clock = std::chrono::steady_clock;
+double ms_since(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
+
+// What the pipelined run's stages hand on.
+struct Decoded {
+  capture::Frame frame;
+  Clock::time_point start;  // when its decoding began: the start of its latency
+  double decode_ms = 0;
+};
+struct Composited {
+  OverlayFrame frame;
+  Clock::time_point start;
+};
 }  // namespace
 
 ReplayOverlay::ReplayOverlay(const std::filesystem::path& recording, const ReplayOverlaySettings& settings)
@@ -70,36 +80,23 @@ void ReplayOverlay::run(int max_frames, const std::function<bool(const OverlayFr
   StageTimes& times = overlay_->times();
   capture::Frame frame;
   for (int n = 0; max_frames <= 0 || n < max_frames; ++n) {
-    const auto start = std::chrono::steady_clock::now();
+    const auto start = Clock::now();
     auto t0 = start;
     if (!frames->read(frame)) break;
     times.decode += ms_since(t0);
 
-    t0 = std::chrono::steady_clock::now();
+    t0 = Clock::now();
     const std::optional<Pose> pose = camera_pose(frame);
     times.pose += ms_since(t0);
 
     const OverlayFrame out = overlay_->composite(frame, pose);
-    t0 = std::chrono::steady_clock::now();
+    t0 = Clock::now();
     const bool go_on = sink(out);
     times.output += ms_since(t0);
     times.latency += ms_since(start);
     if (!go_on) break;
   }
 }
-
-namespace {
-using Clock = std::chrono::steady_clock;
-struct Decoded {
-  capture::Frame frame;
-  Clock::time_point start;  // when its decoding began: the start of its latency
-  double decode_ms = 0;
-};
-struct Composited {
-  OverlayFrame frame;
-  Clock::time_point start;
-};
-}  // namespace
 
 void ReplayOverlay::run_pipelined(int max_frames, const std::function<bool(const OverlayFrame&)>& sink) {
   // Closing a queue ends the stream through it: the producer ran out, or a consumer stopped.
