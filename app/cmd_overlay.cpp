@@ -75,7 +75,8 @@ void write_stats(const OverlayOptions& o, const pipeline::Overlay& overlay,
   if (first) spdlog::info("overlay: first frame composited {:.0f} ms after the command started", startup_ms);
   if (o.stats_json.empty()) return;
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  write_file_atomically(o.stats_json, pipeline::stage_times_json(overlay.times(), wall, startup_ms));
+  write_file_atomically(o.stats_json,
+                        pipeline::stage_times_json(overlay.times(), wall, startup_ms, overlay.quality().describe()));
 }
 
 void report(const pipeline::Overlay& overlay) {
@@ -105,6 +106,8 @@ void run_live(OverlayOptions& o) {
   // A window unless the frames go to files only.
   const bool window = o.window || (o.out.empty() && o.frames_dir.empty());
   live.overlay = overlay_settings(o, window);
+  if (auto_quality(o.composite))
+    throw InputError("--quality auto: chooses on a recording's frames; live, give the knobs (--shading, ...)");
   live.overlay.window_title = "lumar overlay (live)";
   if (window) live.overlay.window_panel_width = ui::kPanelWidth;
   pipeline::LiveOverlay overlay(live);
@@ -140,6 +143,7 @@ void run_replay(const OverlayOptions& o) {
   settings.image_aided = o.image_aided;
   settings.allow_incomplete = o.allow_incomplete;
   settings.overlay = overlay_settings(o, o.window);
+  settings.auto_quality = auto_quality(o.composite);
   if (o.window) settings.overlay.window_panel_width = ui::kPanelWidth;
   pipeline::ReplayOverlay overlay(o.recording, settings);
   const auto& camera = overlay.compositor().output_camera();

@@ -80,6 +80,7 @@ std::optional<pipeline::CompositeError> composite_error(const fs::path& dir, con
   CompositeOptions composite = o.composite;
   composite.without = without;
   apply_composite_options(composite, settings.overlay);
+  settings.auto_quality = auto_quality(composite);
   settings.scene = o.scene;
   settings.overlay.volume_cache = !o.no_cache;
   settings.allow_incomplete = o.allow_incomplete;
@@ -112,6 +113,7 @@ Outcome regress_one(const fs::path& dir, const RegressOptions& o) {
   pipeline::ReplayOverlaySettings settings;
   settings.scene = o.scene;
   apply_composite_options(o.composite, settings.overlay);
+  settings.auto_quality = auto_quality(o.composite);
   settings.overlay.volume_cache = !o.no_cache;
   settings.allow_incomplete = o.allow_incomplete;
   pipeline::ReplayOverlay overlay(dir, settings);

@@ -1,7 +1,11 @@
 #include "commands.h"
 
+#include <fmt/format.h>
+
 #include <map>
 #include <string>
+
+#include "lumar/lighting/irradiance_volume.h"
 
 namespace lumar::app {
 
@@ -32,6 +36,16 @@ void add_composite_options(CLI::App* cmd, CompositeOptions& o) {
   cmd->add_option("--exact-lights", o.exact_lights,
                   "The irradiance volume's exact lights, evaluated with shadow maps (0 to 16; default: the manifest's "
                   "lighting.irradiance.max_lights, else 16; docs/irradiance.md)");
+  cmd->add_option("--quality", o.quality,
+                  "full: the knobs as given; auto: before the run, the cheapest knobs whose composite stays within "
+                  "--quality-budget of theirs, measured on a few of the recording's frames (docs/results.md)")
+      ->capture_default_str();
+  cmd->add_option("--quality-budget", o.quality_budget,
+                  "--quality auto: how far each region (object, edge, shadow) may be from full quality, percent")
+      ->capture_default_str();
+  cmd->add_option("--shadow-map", o.shadow_map,
+                  "Texels per side of each exact light's shadow map (8 to 1024; default: the manifest's "
+                  "lighting.irradiance.shadow_map_resolution, else 128)");
 }
 
 void apply_composite_options(const CompositeOptions& o, pipeline::OverlaySettings& settings) {
@@ -58,15 +72,29 @@ void apply_composite_options(const CompositeOptions& o, pipeline::OverlaySetting
   if (o.blur_sigma_px >= 0) settings.blur_sigma_px = o.blur_sigma_px;
   if (o.shading != "pixel" && o.shading != "vertex")
     throw InputError("--shading " + o.shading + ": use pixel or vertex");
-  settings.shading = o.shading == "vertex" ? ObjectShading::PerVertex : ObjectShading::PerPixel;
+  pipeline::OverlayQuality& q = settings.quality;
+  q.shading = o.shading == "vertex" ? ObjectShading::PerVertex : ObjectShading::PerPixel;
   if (o.shadow_lines < 1 || o.shadow_lines > 64)
     throw InputError("--shadow-lines " + std::to_string(o.shadow_lines) + ": use 1 to 64 lines per patch");
-  settings.shadow_quality.lines_per_patch = o.shadow_lines;
+  q.shadows.lines_per_patch = o.shadow_lines;
   if (o.exact_lights != -1) {
-    if (o.exact_lights < 0 || o.exact_lights > 16)
-      throw InputError("--exact-lights " + std::to_string(o.exact_lights) + ": use 0 to 16");
-    settings.exact_lights = o.exact_lights;
+    if (o.exact_lights < 0 || o.exact_lights > kMaxExactLights)
+      throw InputError(fmt::format("--exact-lights {}: use 0 to {}", o.exact_lights, kMaxExactLights));
+    q.exact_lights = o.exact_lights;
   }
+  if (o.shadow_map != -1) {
+    if (o.shadow_map < 8 || o.shadow_map > 1024)
+      throw InputError(fmt::format("--shadow-map {}: use 8 to 1024 texels per side", o.shadow_map));
+    q.shadow_map = o.shadow_map;
+  }
+}
+
+std::optional<pipeline::QualityBudget> auto_quality(const CompositeOptions& o) {
+  if (o.quality != "full" && o.quality != "auto") throw InputError("--quality " + o.quality + ": use full or auto");
+  if (!(o.quality_budget > 0.0 && o.quality_budget <= 100.0))
+    throw InputError(fmt::format("--quality-budget {}: use a percentage above 0, up to 100", o.quality_budget));
+  if (o.quality == "full") return std::nullopt;
+  return pipeline::QualityBudget{.percent = o.quality_budget};
 }
 
 void add_live_input_options(CLI::App* cmd, pipeline::LiveInputOptions& o, const std::string& camera_help) {

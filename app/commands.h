@@ -7,6 +7,7 @@
 
 #include "lumar/pipeline/live_inputs.h"
 #include "lumar/pipeline/overlay.h"
+#include "lumar/pipeline/quality_choice.h"
 
 namespace lumar::app {
 
@@ -23,7 +24,9 @@ void add_live_input_options(
 // --without and --blur-sigma: what makes rendered pixels look like the camera's
 // (gl::CompositeFeatures); --shading: the objects' light per pixel or per vertex
 // (ObjectShading); --shadow-lines: lines per receiver and emitter patch (ShadowQuality);
-// --exact-lights: the volume's lights evaluated with shadow maps.
+// --exact-lights and --shadow-map: the volume's lights evaluated with shadow maps, and
+// their maps' size (pipeline::OverlayQuality); --quality auto and --quality-budget: those
+// knobs chosen on a recording's frames (pipeline/quality_choice.h).
 // The same names in every command that composites.
 struct CompositeOptions {
   std::string without;
@@ -31,10 +34,16 @@ struct CompositeOptions {
   std::string shading = "pixel";
   int shadow_lines = ShadowQuality{}.lines_per_patch;
   int exact_lights = -1;  // -1: the manifest's
+  int shadow_map = -1;    // -1: the manifest's
+  std::string quality = "full";
+  double quality_budget = pipeline::QualityBudget{}.percent;
 };
 void add_composite_options(CLI::App* cmd, CompositeOptions& o);
 // Applies them to `settings`; InputError names an unknown feature.
 void apply_composite_options(const CompositeOptions& o, pipeline::OverlaySettings& settings);
+// --quality auto: the budget for a replay's choice (ReplayOverlaySettings::auto_quality);
+// nullopt for full. InputError for another word or a budget out of range.
+std::optional<pipeline::QualityBudget> auto_quality(const CompositeOptions& o);
 
 void register_synth(CLI::App& app);
 void register_overlay(CLI::App& app);

@@ -81,24 +81,34 @@ void composite_frame(benchmark::State& state, bool features) {
   state.counters["readback_ms"] = C(after.readback - before.readback, C::kAvgIterations);
 }
 
-// How one replay is run: which recording, shading and threads, and whether H.264 is written.
+// The quality knobs of a replay: full quality per pixel, the same per vertex, or what
+// `--quality auto` chooses on the recording (pipeline/quality_choice.h).
+enum class Knobs { PerPixel, PerVertex, Auto };
+
+// How one replay is run: which recording, knobs and threads, and whether H.264 is written.
 struct Throughput {
-  bool walk = false, vertex = false, pipelined = false, encode = false;
+  bool walk = false;
+  Knobs knobs = Knobs::PerPixel;
+  bool pipelined = false, encode = false;
   std::string label() const {  // within one recording's table
-    return std::string(pipelined ? "pipelined" : "serial") + (vertex ? ", per vertex" : ", per pixel") +
+    return std::string(pipelined ? "pipelined" : "serial") +
+           (knobs == Knobs::PerPixel    ? ", per pixel"
+            : knobs == Knobs::PerVertex ? ", per vertex"
+                                        : ", auto") +
            (encode ? ", H.264" : "");
   }
   std::string name() const { return std::string(walk ? "walk, " : "orbit, ") + label(); }
 };
 
-// One overlay per recording and shading, made (and its shaders compiled) before a clock
-// runs; its stage times add up over every replay of it.
-pipeline::ReplayOverlay& throughput_overlay(bool walk, bool vertex) {
-  static std::map<std::pair<bool, bool>, std::unique_ptr<pipeline::ReplayOverlay>> overlays;
-  auto& overlay = overlays[{walk, vertex}];
+// One overlay per recording and knobs, made (its shaders compiled, auto's choice made)
+// before a clock runs; its stage times add up over every replay of it.
+pipeline::ReplayOverlay& throughput_overlay(bool walk, Knobs knobs) {
+  static std::map<std::pair<bool, Knobs>, std::unique_ptr<pipeline::ReplayOverlay>> overlays;
+  auto& overlay = overlays[{walk, knobs}];
   if (!overlay) {
     pipeline::ReplayOverlaySettings s;
-    s.overlay.shading = vertex ? ObjectShading::PerVertex : ObjectShading::PerPixel;
+    s.overlay.quality.shading = knobs == Knobs::PerVertex ? ObjectShading::PerVertex : ObjectShading::PerPixel;
+    if (knobs == Knobs::Auto) s.auto_quality = pipeline::QualityBudget{};
     overlay = std::make_unique<pipeline::ReplayOverlay>(walk ? kWalk : kRecording, s);
     overlay->run(2, [](const pipeline::OverlayFrame&) { return true; });
   }
@@ -107,7 +117,7 @@ pipeline::ReplayOverlay& throughput_overlay(bool walk, bool vertex) {
 
 // Frames per second and latency over whole replays, through the pipeline library.
 void replay_throughput(benchmark::State& state, Throughput t) {
-  pipeline::ReplayOverlay& overlay = throughput_overlay(t.walk, t.vertex);
+  pipeline::ReplayOverlay& overlay = throughput_overlay(t.walk, t.knobs);
   const auto& camera = overlay.compositor().output_camera();
   const std::string video =
       (std::filesystem::temp_directory_path() / ("lumar-bench-" + std::to_string(::getpid()) + ".mp4")).string();
@@ -152,9 +162,11 @@ int main(int argc, char** argv) {
       ->UseRealTime();
   std::vector<Throughput> throughputs;
   for (bool walk : {false, true})
-    for (const Throughput& t : {Throughput{walk, false, false, false}, Throughput{walk, true, false, false},
-                                Throughput{walk, true, true, false}, Throughput{walk, false, false, true},
-                                Throughput{walk, true, true, true}})
+    for (const Throughput& t :
+         {Throughput{walk, Knobs::PerPixel, false, false}, Throughput{walk, Knobs::PerVertex, false, false},
+          Throughput{walk, Knobs::PerVertex, true, false}, Throughput{walk, Knobs::Auto, true, false},
+          Throughput{walk, Knobs::PerPixel, false, true}, Throughput{walk, Knobs::PerVertex, true, true},
+          Throughput{walk, Knobs::Auto, true, true}})
       throughputs.push_back(t);
   for (const Throughput& t : throughputs)
     benchmark::RegisterBenchmark(("throughput/" + t.name()).c_str(), replay_throughput, t)
@@ -195,7 +207,7 @@ int main(int argc, char** argv) {
                     {"composite, features off", plain->time_ms},
                     {"replay: decode+pose+composite", replay_ms}};
   // The walk shaded per pixel: per stage, over its replays (the overlay's own stage clock).
-  const pipeline::StageTimes& w = throughput_overlay(true, false).times();
+  const pipeline::StageTimes& w = throughput_overlay(true, Knobs::PerPixel).times();
   const double walk_frames = std::max(1, w.frames);
   for (const auto& [name, ms] : std::initializer_list<std::pair<const char*, double>>{
            {"walk: decode video", w.decode},
@@ -224,6 +236,10 @@ int main(int argc, char** argv) {
     table.baseline = table.entries.front().name;
     table.compute_ratios();
     table.save(bench::results_dir());
+    if (const auto& choice = throughput_overlay(walk, Knobs::Auto).quality_choice())
+      std::printf("%s: auto chose %s (%.1f ms per frame in its trials against full quality's %.1f)\n",
+                  walk ? "walk" : "orbit", choice->choice().quality.describe().c_str(), choice->choice().ms_per_frame,
+                  choice->full().ms_per_frame);
   }
   std::printf("replay throughput: %.1f frames/s\n", 1000.0 / replay_ms);
   std::printf(

@@ -136,6 +136,28 @@ PY
     --frames-dir "$TMP/bad"
 }
 
+case_quality_auto() {
+  # --quality auto tries cheaper knobs on a few of the recording's frames before the run,
+  # logs each trial, and the run's figures start after it (its frames are not counted).
+  "$LUMAR" overlay --recording "$REC" --max-frames 3 --quality auto --stats-json "$TMP/stats.json" \
+    >"$TMP/log" 2>&1 || { cat "$TMP/log"; fail "overlay --quality auto failed"; }
+  [ "$(grep -c "quality auto: pixel, 8 lines.*(the reference)" "$TMP/log")" -eq 1 ] || { cat "$TMP/log"; fail "no reference trial"; }
+  [ "$(grep -c "ms/frame; against full quality" "$TMP/log")" -ge 3 ] || { cat "$TMP/log"; fail "too few trials"; }
+  grep -q "within 1.50 % of it" "$TMP/log" || { cat "$TMP/log"; fail "no choice line"; }
+  python3 - "$TMP/stats.json" <<'PY' || fail "bad stats file"
+import json, sys
+s = json.load(open(sys.argv[1]))
+assert s['frames'] == 3, s['frames']
+assert s['quality'].count('lines') == 1, s['quality']
+PY
+  expect_bad_input "--quality" "$TMP/bad" -- "$LUMAR" overlay --recording "$REC" --quality best --frames-dir "$TMP/bad"
+  expect_bad_input "--quality-budget" "$TMP/bad" -- "$LUMAR" overlay --recording "$REC" --quality auto \
+    --quality-budget 0 --frames-dir "$TMP/bad"
+  expect_bad_input "--shadow-map" "$TMP/bad" -- "$LUMAR" overlay --recording "$REC" --shadow-map 4 --frames-dir "$TMP/bad"
+  expect_bad_input "--quality auto" "$TMP/bad" -- "$LUMAR" overlay --source "images:$TMP/none" --quality auto \
+    --frames-dir "$TMP/bad"
+}
+
 case_window_without_display_fails_cleanly() {
   "$LUMAR" overlay --recording "$REC" --window --max-frames 1 >"$TMP/out" 2>"$TMP/err"
   status=$?

@@ -7,6 +7,7 @@
 #include <stdexcept>
 #include <vector>
 
+#include "lumar/base/error.h"
 #include "lumar/pipeline/replay_overlay.h"
 #include "test_paths.h"
 
@@ -20,8 +21,10 @@ pipeline::ReplayOverlaySettings settings(gl::CompositeFeatures features = {}) {
   return s;
 }
 
-std::vector<cv::Mat> composites(bool pipelined, int frames, std::vector<std::int64_t>* indices = nullptr) {
-  pipeline::ReplayOverlay overlay(test::source_dir() / "recordings/orbit", settings());
+std::vector<cv::Mat> composites(bool pipelined, int frames, std::vector<std::int64_t>* indices = nullptr,
+                                const char* recording = "recordings/orbit",
+                                const pipeline::ReplayOverlaySettings& s = settings()) {
+  pipeline::ReplayOverlay overlay(test::source_dir() / recording, s);
   std::vector<cv::Mat> out;
   overlay.run(
       frames,
@@ -48,6 +51,42 @@ TEST(PipelinedReplay, GivesTheSerialRunsFramesInOrder) {
   }
   // Each frame is its own image, not a buffer the next one overwrites.
   EXPECT_GT(cv::norm(pipelined[0], pipelined[9], cv::NORM_L1), 0.0);
+}
+
+// The walk's figurines move every frame: their shadows, bounce and light per vertex are
+// worked out a frame ahead on their own thread (Overlay::prepare) and must be the serial
+// run's, frame by frame.
+TEST(PipelinedReplay, MovingObjectsPreparedAheadGiveTheSerialFrames) {
+  pipeline::ReplayOverlaySettings s = settings();
+  s.overlay.quality.shading = ObjectShading::PerVertex;
+  for (const ObjectShading shading : {ObjectShading::PerVertex, ObjectShading::PerPixel}) {
+    s.overlay.quality.shading = shading;
+    std::vector<std::int64_t> indices;
+    const std::vector<cv::Mat> serial = composites(false, 8, nullptr, "recordings/walk", s),
+                               pipelined = composites(true, 8, &indices, "recordings/walk", s);
+    ASSERT_EQ(pipelined.size(), serial.size());
+    for (std::size_t i = 0; i < serial.size(); ++i) {
+      EXPECT_EQ(indices[i], std::int64_t(i));
+      EXPECT_EQ(cv::norm(serial[i], pipelined[i], cv::NORM_INF), 0.0) << "frame " << i;
+    }
+    // The figurines moved: their shadows with them.
+    EXPECT_GT(cv::norm(pipelined[0], pipelined[7], cv::NORM_L1), 0.0);
+  }
+}
+
+// Lighting adaptation changes the light on the GL thread between frames: nothing is
+// prepared ahead then, and the pipelined run composites each frame whole.
+TEST(PipelinedReplay, WithTheLightingAdaptedNothingIsPreparedAhead) {
+  pipeline::ReplayOverlaySettings s = settings();
+  s.overlay.adapt_lighting_every = 10;
+  pipeline::ReplayOverlay overlay(test::source_dir() / "recordings/walk", s);
+  EXPECT_FALSE(overlay.overlay().can_prepare_ahead());
+  EXPECT_THROW(overlay.overlay().prepare(0), RuntimeError);
+  int seen = 0;
+  overlay.run(
+      3, [&](const pipeline::OverlayFrame&) { return ++seen > 0; }, true);
+  EXPECT_EQ(seen, 3);
+  EXPECT_EQ(overlay.times().frames, 3);
 }
 
 TEST(PipelinedReplay, StopsWhenTheSinkSaysSo) {

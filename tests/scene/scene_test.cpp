@@ -202,6 +202,11 @@ TEST_F(SceneManifest, OtherStructuralErrors) {
   expect_error(write_changed(lighting, R"("lighting": {"irradiance": {"rays_per_probe": 100.5}})"),
                "lighting.irradiance.rays_per_probe", "whole");
   expect_error(write_changed(lighting, R"("lighting": {"irradiance": {"refine": 1}})"), "lighting.irradiance.refine");
+  expect_error(write_changed(lighting, R"("lighting": {"irradiance": {"shadow_map_resolution": 4}})"),
+               "lighting.irradiance.shadow_map_resolution", "8 to 1024");
+  EXPECT_EQ(load_scene(write_changed(lighting, R"("lighting": {"irradiance": {"shadow_map_resolution": 64}})"))
+                .lighting.shadow_map_resolution,
+            64);
   expect_error(write("[1, 2, 3]"), "top level");
 }
 

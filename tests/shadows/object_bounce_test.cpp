@@ -4,10 +4,12 @@
 
 #include <gtest/gtest.h>
 
+#include <tbb/global_control.h>
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <glm/gtc/matrix_transform.hpp>
+#include <tuple>
 
 #include "lumar/base/constants.h"
 #include "lumar/base/error.h"
@@ -181,6 +183,35 @@ TEST(ObjectBounce, SpheresUnderAUniformSkyLightEachOther) {
   bounce.update(uniform);
   for (const glm::vec3& e : bounce.object_bounce(a)) ASSERT_EQ(e, glm::vec3(0.0f));
   EXPECT_THROW(bounce.object_bounce(7), RuntimeError);
+}
+
+TEST(ObjectBounce, TheSameOnOneThreadAsOnTwo) {
+  // The receivers' loop and the clusters' light run in parallel (tbb); each receiver's sum
+  // is its own, so the result must not depend on the threads, bit for bit.
+  std::vector<glm::vec3> positions, normals, without;
+  for (int i = -20; i <= 20; ++i)
+    for (int j = -20; j <= 20; ++j) {
+      positions.push_back({0.05f * float(i), 0.0f, 0.05f * float(j)});
+      normals.push_back({0, 1, 0});
+      without.push_back(glm::vec3(float(kPi)));
+    }
+  // Light that varies with the direction, so every cluster differs.
+  const auto sky = [](const glm::vec3&, const glm::vec3& n) { return glm::vec3(2.0f + n.y, 1.5f + n.x, 1.0f + n.z); };
+  const auto run = [&](int threads) {
+    tbb::global_control limit(tbb::global_control::max_allowed_parallelism, std::size_t(threads));
+    ObjectBounce bounce(positions, normals, without);
+    bounce.add_object(test::make_sphere({0, 0, 0}, 0.2f, 48, 24), glm::vec3(0.8f, 0.4f, 0.2f), translation(0, 0.2, 0));
+    bounce.add_object(test::make_sphere({0, 0, 0}, 0.1f, 32, 16), glm::vec3(0.5f), translation(0.35, 0.1, 0.1));
+    bounce.update(sky);
+    return std::make_tuple(bounce.ratio(), bounce.object_bounce(0), bounce.object_bounce(1), bounce.stats().pairs,
+                           bounce.stats().near_pairs);
+  };
+  const auto one = run(1), two = run(2);
+  EXPECT_GT(std::get<4>(one), 0u) << "receivers under the spheres are summed by triangles";
+  EXPECT_GT(
+      std::count_if(std::get<0>(one).begin(), std::get<0>(one).end(), [](const glm::vec3& r) { return r.x > 0.0f; }),
+      100);
+  EXPECT_TRUE(one == two);
 }
 
 TEST(ObjectBounce, FollowsPoseAlbedoAndSwitch) {

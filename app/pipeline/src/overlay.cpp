@@ -14,6 +14,7 @@
 #include "lumar/base/error.h"
 #include "lumar/calib/camera_blur.h"
 #include "lumar/calib/sensor_noise.h"
+#include "lumar/lighting/irradiance_volume.h"
 
 namespace lumar::pipeline {
 
@@ -33,16 +34,35 @@ gl::VideoRadiometry renderer_radiometry(const capture::Radiometry& radiometry, c
   return out;
 }
 
-// The scene with the exact-light count the settings ask for (a copy only when it differs).
-std::shared_ptr<const LoadedScene> with_exact_lights(std::shared_ptr<const LoadedScene> scene,
-                                                     const std::optional<int>& lights) {
-  if (!lights || scene->manifest.lighting.max_lights == lights) return scene;
-  if (*lights < 0 || *lights > 16) throw InputError("exact lights: " + std::to_string(*lights) + "; use 0 to 16");
+// The scene with the volume's knobs the quality asks for (a copy only when they differ).
+std::shared_ptr<const LoadedScene> with_volume_knobs(std::shared_ptr<const LoadedScene> scene,
+                                                     const OverlayQuality& q) {
+  const LightingSettings& lighting = scene->manifest.lighting;
+  const bool lights = q.exact_lights && lighting.max_lights != q.exact_lights;
+  const bool map = q.shadow_map && lighting.shadow_map_resolution != q.shadow_map;
+  if (!lights && !map) return scene;
   auto copy = std::make_shared<LoadedScene>(*scene);
-  copy->manifest.lighting.max_lights = *lights;
+  if (lights) copy->manifest.lighting.max_lights = q.exact_lights;
+  if (map) copy->manifest.lighting.shadow_map_resolution = q.shadow_map;
   return copy;
 }
+
+void check_quality(const OverlayQuality& q) {
+  if (q.exact_lights && (*q.exact_lights < 0 || *q.exact_lights > kMaxExactLights))
+    throw InputError(fmt::format("exact lights: {}; use 0 to {}", *q.exact_lights, kMaxExactLights));
+  if (q.shadow_map && (*q.shadow_map < 8 || *q.shadow_map > 1024))
+    throw InputError(fmt::format("shadow maps of {} texels per side; use 8 to 1024", *q.shadow_map));
+  if (q.shadows.lines_per_patch < 1 || q.shadows.lines_per_patch > 64)
+    throw InputError(fmt::format("{} shadow lines per patch; use 1 to 64", q.shadows.lines_per_patch));
+}
 }  // namespace
+
+std::string OverlayQuality::describe() const {
+  return fmt::format("{}, {} lines, {} lights, {} shadow maps",
+                     shading == ObjectShading::PerVertex ? "vertex" : "pixel", shadows.lines_per_patch,
+                     exact_lights ? std::to_string(*exact_lights) : "the manifest's",
+                     shadow_map ? std::to_string(*shadow_map) + " px" : "the manifest's");
+}
 
 Overlay::Overlay(std::shared_ptr<const LoadedScene> scene, const CameraIntrinsics& camera,
                  const capture::Radiometry& radiometry, const std::optional<calib::CameraResponse>& response,
@@ -52,7 +72,9 @@ Overlay::Overlay(std::shared_ptr<const LoadedScene> scene, const CameraIntrinsic
       session_radiometry_(radiometry),
       live_(settings.live),
       volume_cache_(settings.volume_cache),
-      exact_lights_(settings.exact_lights) {
+      quality_(settings.quality),
+      scene_(scene) {
+  check_quality(quality_);
   if (settings.window) {
     const char* display = std::getenv("DISPLAY");
     if (!display || !*display)
@@ -69,8 +91,8 @@ Overlay::Overlay(std::shared_ptr<const LoadedScene> scene, const CameraIntrinsic
   }
   maps_ = calib::make_undistortion_maps(camera, settings.undistortion);
   const calib::UndistortionMaps& maps = maps_;
-  compositor_ = std::make_unique<Compositor>(with_exact_lights(std::move(scene), exact_lights_), maps.output,
-                                             maps.map_x, maps.map_y, settings.volume_cache);
+  compositor_ = std::make_unique<Compositor>(with_volume_knobs(std::move(scene), quality_), maps.output, maps.map_x,
+                                             maps.map_y, settings.volume_cache);
   // The renderer's linear unit is the response's (sRGB with gain 1 without one).
   response_ = response.value_or(calib::srgb_response(1.0));
   radiometry_ = renderer_radiometry(radiometry, camera, response);
@@ -78,8 +100,8 @@ Overlay::Overlay(std::shared_ptr<const LoadedScene> scene, const CameraIntrinsic
   blur_known_ = !settings.features.blur;
   if (settings.blur_sigma_px >= 0) radiometry_.blur_sigma_px = settings.blur_sigma_px, blur_known_ = true;
   compositor_->set_features(settings.features);
-  compositor_->set_object_shading(settings.shading);
-  compositor_->set_shadow_quality(settings.shadow_quality);
+  compositor_->set_object_shading(quality_.shading);
+  compositor_->set_shadow_quality(quality_.shadows);
   compositor_->renderer().set_video_radiometry(radiometry_);
   lighting_cells_ = settings.adapt_lighting_cells;
   set_adapt_lighting_every(settings.adapt_lighting_every);
@@ -138,33 +160,72 @@ void Overlay::set_scene(std::shared_ptr<const LoadedScene> scene) {
   // The lighting measured so far was the old scene's map's: start again.
   live_lighting_.reset();
   const gl::CompositeFeatures features = compositor_->renderer().features();
-  const ObjectShading shading = compositor_->object_shading();
-  const ShadowQuality shadow_quality = compositor_->shadow_quality();
+  quality_.shading = compositor_->object_shading();
+  quality_.shadows = compositor_->shadow_quality();
+  scene_ = scene;
   compositor_.reset();  // its GL objects go first
-  compositor_ = std::make_unique<Compositor>(with_exact_lights(std::move(scene), exact_lights_), maps_.output,
-                                             maps_.map_x, maps_.map_y, volume_cache_);
+  compositor_ = std::make_unique<Compositor>(with_volume_knobs(std::move(scene), quality_), maps_.output, maps_.map_x,
+                                             maps_.map_y, volume_cache_);
   compositor_->set_features(features);
-  compositor_->set_object_shading(shading);
-  compositor_->set_shadow_quality(shadow_quality);
+  compositor_->set_object_shading(quality_.shading);
+  compositor_->set_shadow_quality(quality_.shadows);
   compositor_->renderer().set_video_radiometry(radiometry_);
   set_adapt_lighting_every(lighting_every_);
   frames_since_clip_check_ = kClipCheckEvery, clip_warned_ = false;  // other objects may clip
 }
 
-void Overlay::play_paths(Nanos frame_time) {
+void Overlay::set_quality(const OverlayQuality& quality) {
+  check_quality(quality);
+  if (quality.exact_lights != quality_.exact_lights || quality.shadow_map != quality_.shadow_map) {
+    quality_.exact_lights = quality.exact_lights, quality_.shadow_map = quality.shadow_map;
+    // The objects stay where they are; a new compositor would put them back at the manifest's poses.
+    std::vector<glm::dmat4> poses;
+    for (std::size_t i = 0; i < compositor_->scene().objects.size(); ++i) poses.push_back(compositor_->object_pose(i));
+    set_scene(scene_);
+    for (std::size_t i = 0; i < poses.size(); ++i) compositor_->set_object_pose(i, poses[i]);
+  }
+  quality_ = quality;
+  compositor_->set_object_shading(quality.shading);
+  compositor_->set_shadow_quality(quality.shadows);
+}
+
+OverlayQuality Overlay::quality() const {
+  OverlayQuality q = quality_;
+  q.shading = compositor_->object_shading();
+  q.shadows = compositor_->shadow_quality();
+  return q;
+}
+
+void Overlay::play_paths(Nanos frame_time) { move_along_paths(frame_time, true); }
+
+void Overlay::move_along_paths(Nanos frame_time, bool renderer_too) {
   if (!first_frame_time_) first_frame_time_ = frame_time;
   const double t_s = nanos_to_seconds(live_ ? frame_time - *first_frame_time_ : frame_time);
   const auto& objects = compositor_->scene().objects;
   for (std::size_t i = 0; i < objects.size(); ++i)
-    if (!objects[i].path.empty()) compositor_->set_object_pose(i, objects[i].pose_at(t_s));
+    if (!objects[i].path.empty()) {
+      if (renderer_too)
+        compositor_->set_object_pose(i, objects[i].pose_at(t_s));
+      else
+        compositor_->move_object(i, objects[i].pose_at(t_s));
+    }
 }
 
-Overlay::~Overlay() {
-  compositor_.reset();  // GL objects go before their context
-  context_.reset();
+FrameLight Overlay::prepare(Nanos frame_time) {
+  if (!can_prepare_ahead())
+    throw RuntimeError("overlay: cannot prepare frames ahead while the lighting is adapted; use composite()");
+  move_along_paths(frame_time, false);
+  return compositor_->prepare();
 }
 
-OverlayFrame Overlay::composite(const capture::Frame& frame, const std::optional<Pose>& T_world_camera) {
+OverlayFrame Overlay::render(const capture::Frame& frame, const std::optional<Pose>& T_world_camera,
+                             const FrameLight& light) {
+  OverlayFrame out = begin(frame, T_world_camera);
+  draw(out, frame, light);
+  return out;
+}
+
+OverlayFrame Overlay::begin(const capture::Frame& frame, const std::optional<Pose>& T_world_camera) {
   OverlayFrame out;
   out.index = frame.index;
   out.time = frame.time;
@@ -174,10 +235,20 @@ OverlayFrame Overlay::composite(const capture::Frame& frame, const std::optional
   // A process may hold several overlays (the benchmark's with and without features),
   // each with its own context: draw in this one's.
   context_->make_current();
-  play_paths(frame.time);
   const auto measure_start = std::chrono::steady_clock::now();
   measure_camera(frame.image);
   times_.measure += ms_since(measure_start);
+  return out;
+}
+
+Overlay::~Overlay() {
+  compositor_.reset();  // GL objects go before their context
+  context_.reset();
+}
+
+OverlayFrame Overlay::composite(const capture::Frame& frame, const std::optional<Pose>& T_world_camera) {
+  OverlayFrame out = begin(frame, T_world_camera);
+  play_paths(frame.time);
   if (live_lighting_ && T_world_camera) {
     const auto t0 = std::chrono::steady_clock::now();
     live_lighting_->update(*compositor_, frame.image, *T_world_camera, frame.time);
@@ -185,8 +256,14 @@ OverlayFrame Overlay::composite(const capture::Frame& frame, const std::optional
     out.lighting_settled = !live_lighting_->transition();
     times_.lighting += ms_since(t0);
   }
+  draw(out, frame, compositor_->prepare());
+  return out;
+}
+
+void Overlay::draw(OverlayFrame& out, const capture::Frame& frame, const FrameLight& light) {
+  const std::optional<Pose>& T_world_camera = out.T_world_camera;
   gl::OverlayTimings gt;
-  out.composite = compositor_->composite(frame.image, T_world_camera, exposure_ * exposure_scale_, &gt);
+  out.composite = compositor_->render(light, frame.image, T_world_camera, exposure_ * exposure_scale_, &gt);
   times_.shadows += gt.shadows_ms;
   times_.vertex_light += gt.vertex_light_ms;
   times_.upload += gt.upload_ms;
@@ -199,7 +276,6 @@ OverlayFrame Overlay::composite(const capture::Frame& frame, const std::optional
   if (T_world_camera && ++frames_since_clip_check_ >= kClipCheckEvery) measure_clipping(out.composite, *T_world_camera);
   ++times_.frames;
   if (!first_composite_) first_composite_ = std::chrono::steady_clock::now();
-  return out;
 }
 
 void Overlay::measure_clipping(const cv::Mat& composite, const Pose& T_world_camera) {
@@ -253,7 +329,7 @@ std::string format_stage_times(const StageTimes& t) {
   return text;
 }
 
-std::string stage_times_json(const StageTimes& t, double wall_seconds, double startup_ms) {
+std::string stage_times_json(const StageTimes& t, double wall_seconds, double startup_ms, const std::string& quality) {
   const int n = std::max(1, t.frames);
   nlohmann::json stages = nlohmann::json::object();
   for (const auto& [name, ms] : t.stages()) stages[name] = ms / n;
@@ -261,6 +337,7 @@ std::string stage_times_json(const StageTimes& t, double wall_seconds, double st
                               {"fps", wall_seconds > 0 ? t.frames / wall_seconds : 0.0},
                               {"latency_ms_mean", t.latency / n},
                               {"startup_ms", startup_ms >= 0 ? nlohmann::json(startup_ms) : nlohmann::json()},
+                              {"quality", quality.empty() ? nlohmann::json() : nlohmann::json(quality)},
                               {"stages", stages}};
   return out.dump(2) + "\n";
 }

@@ -21,6 +21,10 @@ struct Decoded {
   Clock::time_point start;  // when its decoding began: the start of its latency
   double decode_ms = 0;
 };
+struct Prepared {
+  Decoded decoded;
+  std::optional<FrameLight> light;  // its shadows and light, worked out ahead (Overlay::prepare)
+};
 struct Composited {
   OverlayFrame frame;
   Clock::time_point start;
@@ -45,6 +49,24 @@ ReplayOverlay::ReplayOverlay(const std::filesystem::path& recording, const Repla
   overlay_ = std::make_unique<Overlay>(std::move(scene), session.camera, session.radiometry,
                                        calib::calibrated_response(session.radiometry, recording), settings.overlay);
   set_pose_source(pose_source_);
+  if (settings.auto_quality) {
+    quality_choice_ =
+        choose_quality(*overlay_, probe_frames(settings.auto_quality->frames + 1), *settings.auto_quality);
+    set_pose_source(pose_source_);  // the fusion starts again with the run's first frame
+  }
+}
+
+std::vector<ProbeFrame> ReplayOverlay::probe_frames(int count) {
+  std::vector<ProbeFrame> out;
+  const std::size_t total = replay_.reader().frames().size();
+  auto frames = replay_.open_frames();
+  capture::Frame frame;
+  for (std::size_t i = 0; int(out.size()) < count && frames->read(frame); ++i) {
+    if (i * std::size_t(count) < out.size() * total) continue;  // before the next one's place
+    if (const std::optional<Pose> pose = camera_pose(frame))
+      out.push_back({{frame.image.clone(), frame.time, frame.index}, *pose});  // a source may reuse its buffer
+  }
+  return out;
 }
 
 void ReplayOverlay::set_pose_filter(const std::optional<tracking::PoseFilterSettings>& filter) {
@@ -100,9 +122,18 @@ void ReplayOverlay::run(int max_frames, const std::function<bool(const OverlayFr
 
 void ReplayOverlay::run_pipelined(int max_frames, const std::function<bool(const OverlayFrame&)>& sink) {
   // Closing a queue ends the stream through it: the producer ran out, or a consumer stopped.
+  // With the lighting fixed, a fourth thread works out each frame's shadows and light
+  // (Overlay::prepare) while the frame before is drawn.
+  const bool ahead = overlay_->can_prepare_ahead();
   StageQueue<Decoded> decoded(kPipelineDepth);
+  StageQueue<Prepared> prepared(kPipelineDepth);
   StageQueue<Composited> composited(kPipelineDepth);
-  std::exception_ptr decode_error, sink_error;
+  const auto close_all = [&] {
+    decoded.close();
+    prepared.close();
+    composited.close();
+  };
+  std::exception_ptr decode_error, prepare_error, sink_error;
   double output_ms = 0, latency_ms = 0;  // the sink thread's, added to the times once it joined
 
   std::thread decoder([&, frames = replay_.open_frames()] {
@@ -119,6 +150,19 @@ void ReplayOverlay::run_pipelined(int max_frames, const std::function<bool(const
     }
     decoded.close();
   });
+  std::thread preparer([&] {
+    if (!ahead) return;
+    try {
+      for (Decoded d; decoded.pop(d);) {
+        FrameLight light = overlay_->prepare(d.frame.time);
+        if (!prepared.push(Prepared{std::move(d), std::move(light)})) break;
+      }
+    } catch (...) {
+      prepare_error = std::current_exception();
+    }
+    prepared.close();
+    decoded.close();
+  });
   std::thread writer([&] {
     try {
       for (Composited c; composited.pop(c);) {
@@ -131,29 +175,36 @@ void ReplayOverlay::run_pipelined(int max_frames, const std::function<bool(const
     } catch (...) {
       sink_error = std::current_exception();
     }
-    composited.close();  // the compositing loop stops at its next push
-    decoded.close();
+    close_all();  // the other stages stop at their next push or pop
   });
   StageTimes& times = overlay_->times();
   std::exception_ptr composite_error;
   try {
-    for (Decoded d; decoded.pop(d);) {
-      times.decode += d.decode_ms;
+    // The next frame, prepared ahead or not.
+    const auto next = [&](Prepared& p) {
+      if (ahead) return prepared.pop(p);
+      p.light.reset();
+      return decoded.pop(p.decoded);
+    };
+    for (Prepared p; next(p);) {
+      times.decode += p.decoded.decode_ms;
       const auto t0 = Clock::now();
-      const std::optional<Pose> pose = camera_pose(d.frame);
+      const std::optional<Pose> pose = camera_pose(p.decoded.frame);
       times.pose += ms_since(t0);
-      if (!composited.push(Composited{overlay_->composite(d.frame, pose), d.start})) break;
+      OverlayFrame out =
+          p.light ? overlay_->render(p.decoded.frame, pose, *p.light) : overlay_->composite(p.decoded.frame, pose);
+      if (!composited.push(Composited{std::move(out), p.decoded.start})) break;
     }
   } catch (...) {
     composite_error = std::current_exception();
   }
-  decoded.close();
-  composited.close();
+  close_all();
   decoder.join();
+  preparer.join();
   writer.join();
   times.output += output_ms;
   times.latency += latency_ms;
-  for (const std::exception_ptr& e : {composite_error, sink_error, decode_error})
+  for (const std::exception_ptr& e : {composite_error, prepare_error, sink_error, decode_error})
     if (e) std::rethrow_exception(e);
 }
 

@@ -42,7 +42,7 @@ std::optional<TruthComparison> compare_with_truth(const std::filesystem::path& d
     return true;
   });
   const double ms = frames > 1 ? (total_ms() - after_first) / (frames - 1) : total_ms();
-  return TruthComparison{meter.result(), ms};
+  return TruthComparison{meter.result(), ms, overlay.quality_choice()};
 }
 
 }  // namespace lumar::pipeline

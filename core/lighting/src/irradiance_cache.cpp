@@ -14,9 +14,9 @@ namespace lumar {
 
 namespace {
 
-// Version 3: probes inside geometry are found with back faces winning ties between
-// coincident faces (RayScene::intersect), so volumes built before may differ.
-constexpr char kMagic[8] = {'L', 'U', 'M', 'A', 'R', 'I', 'V', '3'};
+// Version 4: the shadow maps' resolution is a setting. Version 3: probes inside geometry
+// are found with back faces winning ties between coincident faces (RayScene::intersect).
+constexpr char kMagic[8] = {'L', 'U', 'M', 'A', 'R', 'I', 'V', '4'};
 
 // Settings as plain numbers, in a fixed order (the file and the hash use it).
 template <class F>
@@ -24,7 +24,7 @@ void visit_settings(VolumeSettings& s, F&& f) {
   int storage = int(s.storage), sep = s.separate_lights, refine = s.refine, vis = s.visibility;
   f(storage), f(s.octahedral_resolution), f(sep), f(s.rays_per_probe), f(s.depth_resolution), f(s.spacing);
   f(refine), f(vis), f(s.radiance.map_height), f(s.radiance.bright_fraction), f(s.radiance.bright_min_ratio);
-  f(s.radiance.max_lights), f(s.radiance.max_light_solid_angle);
+  f(s.radiance.max_lights), f(s.radiance.max_light_solid_angle), f(s.shadow_map_resolution);
   s.storage = ProbeStorage(storage), s.separate_lights = sep, s.refine = refine, s.visibility = vis;
 }
 

@@ -11,6 +11,7 @@ VolumeSettings scene_volume_settings(const LightingSettings& lighting, const std
   if (lighting.rays_per_probe) s.rays_per_probe = *lighting.rays_per_probe;
   if (lighting.octahedral_resolution) s.octahedral_resolution = *lighting.octahedral_resolution;
   if (lighting.max_lights) s.radiance.max_lights = *lighting.max_lights;
+  if (lighting.shadow_map_resolution) s.shadow_map_resolution = *lighting.shadow_map_resolution;
   if (lighting.refine) s.refine = *lighting.refine;
   if (lighting.visibility) s.visibility = *lighting.visibility;
   return s;

@@ -18,7 +18,6 @@ namespace lumar {
 namespace {
 
 constexpr double kDepthSharpness = 20.0;  // cosine power that spreads ray distances over moment texels
-constexpr int kShadowResolution = 128;    // light shadow maps: ~1.4 degrees per texel
 
 std::vector<glm::dvec3> fibonacci_directions(int count) {
   std::vector<glm::dvec3> out(std::size_t(std::max(count, 1)));
@@ -43,6 +42,8 @@ std::string VolumeSettings::describe() const {
                   : storage == ProbeStorage::octahedral ? "oct" + std::to_string(octahedral_resolution)
                                                         : "sh9+oct" + std::to_string(octahedral_resolution);
   if (separate_lights) s += "+lights";
+  if (separate_lights && shadow_map_resolution != VolumeSettings{}.shadow_map_resolution)
+    s += " (shadow maps " + std::to_string(shadow_map_resolution) + " px)";
   s += ", " + std::to_string(rays_per_probe) + " rays";
   if (radiance.bright_fraction <= 0.0) s += ", no bright texels";
   s += ", spacing " + std::to_string(spacing).substr(0, 4) + (refine ? " + refined" : "");
@@ -474,7 +475,7 @@ IrradianceVolume IrradianceVolume::build(const RoomRadiance& radiance, const glm
       v.lights.push_back({l.power / l.solid_angle, l.solid_angle, l.direction, l.on_proxy, l.position, l.normal});
   v.light_visibility.assign(std::size_t(P) * v.lights.size(), 0.0f);
   if (settings.separate_lights && !v.lights.empty()) {
-    const int n = kShadowResolution;
+    const int n = std::max(2, settings.shadow_map_resolution);
     v.shadow_n = n;
     v.light_shadow.assign(std::size_t(n) * n * v.lights.size(), 0.0f);
     const RayScene& rays = *radiance.ray_scene();

@@ -2,6 +2,8 @@
 
 #include <spdlog/spdlog.h>
 
+#include <tbb/task_group.h>
+
 #include <chrono>
 
 #include "lumar/base/error.h"
@@ -152,11 +154,15 @@ void Compositor::set_shadow_quality(const ShadowQuality& quality) {
 }
 
 void Compositor::set_object_pose(std::size_t index, const glm::dmat4& T_world_model) {
+  move_object(index, T_world_model);
+  renderer_->set_object_pose(int(index), T_world_model);
+}
+
+void Compositor::move_object(std::size_t index, const glm::dmat4& T_world_model) {
   if (poses_.at(index) == T_world_model) return;
   poses_[index] = T_world_model;
   pose_object_points();
   vertex_light_stale_[index] = 1;
-  renderer_->set_object_pose(int(index), T_world_model);
   if (shadows_) shadows_->set_object_pose(int(index), T_world_model);
   if (object_shadows_) object_shadows_->set_object_pose(int(index), T_world_model);
   if (bounce_) bounce_->set_object_pose(int(index), T_world_model);
@@ -199,15 +205,15 @@ void Compositor::set_object_shading(ObjectShading shading) {
 }
 
 // Per-vertex shading: the stale objects' light from the volume, with their self-occlusion when it is on.
-void Compositor::light_vertices() {
+void Compositor::light_vertices(FrameLight& light) {
+  light.vertex_irradiance.assign(scene_->objects.size(), std::nullopt);
   if (shading_ != ObjectShading::PerVertex || !volume_) return;
   const bool occluded = renderer_->features().self_occlusion && !self_occlusion_.empty();
   for (std::size_t i = 0; i < scene_->objects.size(); ++i) {
     if (!vertex_light_stale_[i]) continue;
     const std::span<const VertexOcclusion> occlusion =
         occluded ? std::span<const VertexOcclusion>(self_occlusion_[i]) : std::span<const VertexOcclusion>();
-    renderer_->set_object_vertex_irradiance(
-        int(i), vertex_irradiance(scene_->objects[i].model, poses_[i], occlusion, *volume_));
+    light.vertex_irradiance[i] = vertex_irradiance(scene_->objects[i].model, poses_[i], occlusion, *volume_);
     vertex_light_stale_[i] = 0;
   }
 }
@@ -223,14 +229,15 @@ void Compositor::set_object_albedo(std::size_t index, const glm::vec3& albedo) {
   if (bounce_) bounce_->set_object_albedo(int(index), albedo);
 }
 
-// The light the objects reflect onto each other (with two or more), or none.
-void Compositor::upload_object_bounce(bool on) {
-  if (!bounce_ || scene_->objects.size() < 2) return;
+// The light the objects reflect onto each other (with two or more), per object, or none.
+std::vector<std::vector<glm::vec3>> Compositor::object_bounce(bool on) const {
+  std::vector<std::vector<glm::vec3>> out;
+  if (!bounce_ || scene_->objects.size() < 2) return out;
   for (std::size_t i = 0; i < scene_->objects.size(); ++i) {
     const std::vector<glm::vec3>& received = bounce_->object_bounce(int(i));
-    renderer_->set_object_bounce_light(int(i),
-                                       on ? received : std::vector<glm::vec3>(received.size(), glm::vec3(0.0f)));
+    out.push_back(on ? received : std::vector<glm::vec3>(received.size(), glm::vec3(0.0f)));
   }
+  return out;
 }
 
 void Compositor::set_shadows_enabled(bool on, bool on_each_other) {
@@ -239,7 +246,8 @@ void Compositor::set_shadows_enabled(bool on, bool on_each_other) {
     shadows_uploaded_ = false;
     if (shadows_ && !on) {
       renderer_->set_receiver_attenuation(std::vector<glm::vec3>(shadows_->attenuation().size(), glm::vec3(1.0f)));
-      upload_object_bounce(false);
+      const auto none = object_bounce(false);
+      for (std::size_t i = 0; i < none.size(); ++i) renderer_->set_object_bounce_light(int(i), none[i]);
     }
   }
   if (on_each_other != object_shadows_enabled_) {
@@ -254,29 +262,57 @@ void Compositor::set_shadows_enabled(bool on, bool on_each_other) {
 
 cv::Mat Compositor::composite(const cv::Mat& video_bgr8, const std::optional<Pose>& T_world_camera, double exposure,
                               gl::OverlayTimings* timings) {
+  return render(prepare(), video_bgr8, T_world_camera, exposure, timings);
+}
+
+FrameLight Compositor::prepare() {
+  FrameLight light;
+  light.poses = poses_;
   const auto t0 = std::chrono::steady_clock::now();
-  if (shadows_ && shadows_enabled_) {
-    const bool bounce = bounce_ && renderer_->features().bounce;
-    bool changed = shadows_->update();
-    if (bounce) changed |= bounce_->update(object_irradiance(volume_.get(), sh_));
-    if (changed || !shadows_uploaded_) {
-      renderer_->set_receiver_attenuation(bounce ? with_bounce(shadows_->attenuation(), *bounce_)
-                                                 : shadows_->attenuation());
-      upload_object_bounce(bounce);
-      shadows_uploaded_ = true;
-    }
+  // The lines, the bounce and the objects' shadows on each other do not share state: they
+  // run side by side (and the bounce over the receivers within).
+  const bool lines = shadows_ && shadows_enabled_, bounce = lines && bounce_ && renderer_->features().bounce;
+  const bool on_each_other = object_shadows_ && object_shadows_enabled_;
+  bool lines_changed = false, bounce_changed = false, others_changed = false;
+  {
+    tbb::task_group group;
+    if (bounce) group.run([&] { bounce_changed = bounce_->update(object_irradiance(volume_.get(), sh_)); });
+    if (on_each_other) group.run([&] { others_changed = object_shadows_->update(); });
+    group.run_and_wait([&] {
+      if (lines) lines_changed = shadows_->update();
+    });
   }
-  if (object_shadows_ && object_shadows_enabled_ && (object_shadows_->update() || !object_shadows_uploaded_)) {
+  if (lines && (lines_changed || bounce_changed || !shadows_uploaded_)) {
+    light.receiver_attenuation = bounce ? with_bounce(shadows_->attenuation(), *bounce_) : shadows_->attenuation();
+    light.object_bounce = object_bounce(bounce);
+    shadows_uploaded_ = true;
+  }
+  if (on_each_other && (others_changed || !object_shadows_uploaded_)) {
     for (std::size_t i = 0; i < object_shadows_->object_count(); ++i)
-      renderer_->set_object_light_attenuation(int(i), object_shadows_->vertex_attenuation(int(i)));
+      light.object_shadowing.push_back(object_shadows_->vertex_attenuation(int(i)));
     object_shadows_uploaded_ = true;
   }
   const auto t1 = std::chrono::steady_clock::now();
-  light_vertices();
+  light_vertices(light);
+  light.shadows_ms = std::chrono::duration<double, std::milli>(t1 - t0).count();
+  light.vertex_light_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t1).count();
+  return light;
+}
+
+cv::Mat Compositor::render(const FrameLight& light, const cv::Mat& video_bgr8,
+                           const std::optional<Pose>& T_world_camera, double exposure, gl::OverlayTimings* timings) {
+  for (std::size_t i = 0; i < light.poses.size(); ++i) renderer_->set_object_pose(int(i), light.poses[i]);
+  if (light.receiver_attenuation) renderer_->set_receiver_attenuation(*light.receiver_attenuation);
+  for (std::size_t i = 0; i < light.object_bounce.size(); ++i)
+    renderer_->set_object_bounce_light(int(i), light.object_bounce[i]);
+  for (std::size_t i = 0; i < light.object_shadowing.size(); ++i)
+    renderer_->set_object_light_attenuation(int(i), light.object_shadowing[i]);
+  for (std::size_t i = 0; i < light.vertex_irradiance.size(); ++i)
+    if (light.vertex_irradiance[i]) renderer_->set_object_vertex_irradiance(int(i), *light.vertex_irradiance[i]);
   if (timings) {
     *timings = {};
-    timings->shadows_ms = std::chrono::duration<double, std::milli>(t1 - t0).count();
-    timings->vertex_light_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t1).count();
+    timings->shadows_ms = light.shadows_ms;
+    timings->vertex_light_ms = light.vertex_light_ms;
   }
   return renderer_->render_overlay(video_bgr8, T_world_camera, exposure, timings);
 }

@@ -207,9 +207,9 @@ GlName IrradianceTextures::atlas(GLenum internal_format, GLenum format, int widt
 }
 
 IrradianceTextures::IrradianceTextures(const IrradianceVolume& v) {
-  if (v.lights.size() > std::size_t(kMaxVolumeLights))
+  if (v.lights.size() > std::size_t(kMaxExactLights))
     throw InputError("irradiance volume has " + std::to_string(v.lights.size()) +
-                     " lights; the GPU path takes at most " + std::to_string(kMaxVolumeLights) +
+                     " lights; the GPU path takes at most " + std::to_string(kMaxExactLights) +
                      " (lower lighting.irradiance.max_lights)");
   probes_ = buffer_texture(GL_RGBA32F, v.probes.data(), v.probes.size() * sizeof(glm::vec4));
   node_probe_ = buffer_texture(GL_RGBA32I, v.node_probe.data(), v.node_probe.size() * sizeof(std::array<int, 4>));

@@ -12,8 +12,6 @@ namespace lumar::gl {
 // vec3 volume_irradiance(vec3 p, vec3 n). Texture units 8..15.
 extern const char* const kIrradianceVolumeGlsl;
 
-constexpr int kMaxVolumeLights = 16;
-
 class IrradianceTextures {
  public:
   // Throws InputError when the volume has more lights than the shader takes.

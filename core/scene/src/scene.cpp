@@ -274,7 +274,9 @@ LightingSettings read_lighting(const ManifestReader& r, const json& doc) {
   if (!v.contains("irradiance")) return out;
   const json& q = r.object(v, "lighting", "irradiance");
   const std::string k = "lighting.irradiance";
-  r.only_keys(q, k, {"spacing", "rays_per_probe", "octahedral_resolution", "max_lights", "refine", "visibility"});
+  r.only_keys(q, k,
+              {"spacing", "rays_per_probe", "octahedral_resolution", "max_lights", "shadow_map_resolution", "refine",
+               "visibility"});
   const auto in_range = [&](const char* name, double lo, double hi) -> std::optional<double> {
     if (!q.contains(name)) return std::nullopt;
     const double d = r.number(q.at(name), k + "." + name);
@@ -290,6 +292,7 @@ LightingSettings read_lighting(const ManifestReader& r, const json& doc) {
   out.rays_per_probe = integer("rays_per_probe", 16, 65536);
   out.octahedral_resolution = integer("octahedral_resolution", 2, 64);
   out.max_lights = integer("max_lights", 0, 32);
+  out.shadow_map_resolution = integer("shadow_map_resolution", 8, 1024);
   if (q.contains("refine")) out.refine = r.boolean_or(q, k, "refine", true);
   if (q.contains("visibility")) out.visibility = r.boolean_or(q, k, "visibility", true);
   return out;

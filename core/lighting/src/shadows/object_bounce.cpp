@@ -1,6 +1,9 @@
 #include "lumar/lighting/shadows/object_bounce.h"
 
 #include <immintrin.h>
+#include <tbb/blocked_range.h>
+#include <tbb/combinable.h>
+#include <tbb/parallel_for.h>
 #include <algorithm>
 #include <array>
 #include <chrono>
@@ -282,8 +285,10 @@ bool ObjectBounce::update(const Irradiance& irradiance) {
   stats_ = {};
   stats_.recomputed = true;
   std::fill(bounce_.begin(), bounce_.end(), glm::vec3(0.0f));
+  for (Object& o : objects_)
+    if (o.enabled && !o.surface.clusters.empty()) light_clusters(o, irradiance);
   for (const Object& o : objects_)
-    if (o.enabled && !o.surface.clusters.empty()) add_object_bounce(o, irradiance, positions_, normals_, bounce_);
+    if (o.enabled && !o.surface.clusters.empty()) add_object_bounce(o, positions_, normals_, bounce_);
   // Onto each other: every object's vertices, posed, receive from the others.
   const auto t1 = std::chrono::steady_clock::now();
   for (std::size_t b = 0; b < objects_.size(); ++b) {
@@ -293,7 +298,7 @@ bool ObjectBounce::update(const Irradiance& irradiance) {
     const Mesh posed = transformed(to.model, to.T_world_model);
     for (std::size_t a = 0; a < objects_.size(); ++a)
       if (a != b && objects_[a].enabled && !objects_[a].surface.clusters.empty())
-        add_object_bounce(objects_[a], irradiance, posed.positions, posed.normals, to.received);
+        add_object_bounce(objects_[a], posed.positions, posed.normals, to.received);
   }
   stats_.onto_objects_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t1).count();
   for (std::size_t i = 0; i < positions_.size(); ++i) {
@@ -310,16 +315,29 @@ const std::vector<glm::vec3>& ObjectBounce::object_bounce(int id) const {
   return objects_[std::size_t(id)].received;
 }
 
-void ObjectBounce::add_object_bounce(const Object& o, const Irradiance& irradiance,
-                                     std::span<const glm::vec3> positions, std::span<const glm::vec3> normals,
-                                     std::span<glm::vec3> out) {
+// The volume's evaluation per cluster is most of a frame's cost outside the receivers'
+// loop: once per update, in parallel.
+void ObjectBounce::light_clusters(Object& o, const Irradiance& irradiance) {
+  const glm::dmat3 linear(o.T_world_model);
+  const glm::mat3 rotate(linear / std::cbrt(std::abs(glm::determinant(linear))));
+  const glm::mat4 Tf(o.T_world_model);
+  const glm::vec3 albedo_over_pi = o.albedo / float(kPi);
+  o.cluster_radiance.resize(o.surface.clusters.size());
+  tbb::parallel_for(std::size_t(0), o.surface.clusters.size(), [&](std::size_t k) {
+    const glm::vec3 centre = glm::vec3(Tf * glm::vec4(o.surface.clusters[k].centre, 1.0f));
+    const float open = o.cluster_open[k];
+    o.cluster_radiance[k] = albedo_over_pi * open * irradiance(centre, rotate * o.cluster_bent[k]) * open;
+  });
+}
+
+void ObjectBounce::add_object_bounce(const Object& o, std::span<const glm::vec3> positions,
+                                     std::span<const glm::vec3> normals, std::span<glm::vec3> out) {
   const glm::dmat4& T = o.T_world_model;
   const glm::dmat3 linear(T);
   const double scale = std::cbrt(std::abs(glm::determinant(linear)));
   const glm::mat3 rotate(linear / scale);
   const glm::mat4 Tf(T);
   const float area_scale = float(scale * scale);
-  const glm::vec3 albedo_over_pi = o.albedo / float(kPi);
   const Mesh& m = o.model;
   const glm::vec3 middle = glm::vec3(Tf * glm::vec4(o.middle, 1.0f));
   const float reach = float(settings_.reach * scale) * std::max(o.radius, 1e-6f);
@@ -332,12 +350,10 @@ void ObjectBounce::add_object_bounce(const Object& o, const Irradiance& irradian
   const std::size_t n = clusters.size(), padded = (n + 3) / 4 * 4;
   std::vector<float> px(padded, 0.0f), py(padded, 0.0f), pz(padded, 0.0f), nx(padded, 0.0f), ny(padded, 0.0f),
       nz(padded, 0.0f), fr(padded, 0.0f), fg(padded, 0.0f), fb(padded, 0.0f), near2(padded, 0.0f);
-  std::vector<glm::vec3> radiance(n);
+  const std::vector<glm::vec3>& radiance = o.cluster_radiance;
   for (std::size_t k = 0; k < n; ++k) {
     const SurfaceCluster& c = clusters[k];
     const glm::vec3 centre = glm::vec3(Tf * glm::vec4(c.centre, 1.0f));
-    const float open = o.cluster_open[k];
-    radiance[k] = albedo_over_pi * open * irradiance(centre, rotate * o.cluster_bent[k]) * open;
     const glm::vec3 flux = radiance[k] * c.area * area_scale;
     const glm::vec3 geometric = rotate * c.normal;
     px[k] = centre.x, py[k] = centre.y, pz[k] = centre.z;
@@ -357,77 +373,92 @@ void ObjectBounce::add_object_bounce(const Object& o, const Irradiance& irradian
     triangle_facing[t] = rotate * o.triangle_facing[t];
   }
 
-  std::vector<std::uint32_t> near;
-  for (std::size_t i = 0; i < positions.size(); ++i) {
-    const glm::vec3 x = positions[i], nrm = normals[i];
-    if (glm::length(x - middle) > reach) continue;
-    near.clear();
-    // Far clusters as points, four at a time: A cos θ_c cos θ_x / r², the cosines being
-    // dot products over r, both clamped at 0 (facing is the visibility).
-    const __m128 xx = _mm_set1_ps(x.x), xy = _mm_set1_ps(x.y), xz = _mm_set1_ps(x.z);
-    const __m128 mx = _mm_set1_ps(nrm.x), my = _mm_set1_ps(nrm.y), mz = _mm_set1_ps(nrm.z);
-    const __m128 zero = _mm_setzero_ps(), tiny = _mm_set1_ps(1e-30f);
-    __m128 sr = zero, sg = zero, sb = zero;
-    for (std::size_t k = 0; k < padded; k += 4) {
-      const __m128 dx = _mm_sub_ps(_mm_loadu_ps(&px[k]), xx), dy = _mm_sub_ps(_mm_loadu_ps(&py[k]), xy),
-                   dz = _mm_sub_ps(_mm_loadu_ps(&pz[k]), xz);
-      const __m128 r2 = _mm_add_ps(_mm_add_ps(_mm_mul_ps(dx, dx), _mm_mul_ps(dy, dy)), _mm_mul_ps(dz, dz));
-      const __m128 cos_x = _mm_add_ps(_mm_add_ps(_mm_mul_ps(dx, mx), _mm_mul_ps(dy, my)), _mm_mul_ps(dz, mz));
-      const __m128 cos_c =
-          _mm_add_ps(_mm_add_ps(_mm_mul_ps(dx, _mm_loadu_ps(&nx[k])), _mm_mul_ps(dy, _mm_loadu_ps(&ny[k]))),
-                     _mm_mul_ps(dz, _mm_loadu_ps(&nz[k])));
-      const __m128 is_near = _mm_cmplt_ps(r2, _mm_loadu_ps(&near2[k]));
-      if (const int bits = _mm_movemask_ps(is_near))
-        for (int j = 0; j < 4; ++j)
-          if (bits & (1 << j)) near.push_back(std::uint32_t(k) + std::uint32_t(j));
-      // cos_c is the outgoing cosine's negative (d points from the receiver to the cluster).
-      const __m128 g = _mm_andnot_ps(
-          is_near, _mm_div_ps(_mm_mul_ps(_mm_max_ps(cos_x, zero), _mm_max_ps(_mm_sub_ps(zero, cos_c), zero)),
-                              _mm_add_ps(_mm_mul_ps(r2, r2), tiny)));
-      sr = _mm_add_ps(sr, _mm_mul_ps(g, _mm_loadu_ps(&fr[k])));
-      sg = _mm_add_ps(sg, _mm_mul_ps(g, _mm_loadu_ps(&fg[k])));
-      sb = _mm_add_ps(sb, _mm_mul_ps(g, _mm_loadu_ps(&fb[k])));
-    }
-    alignas(16) float r4[4], g4[4], b4[4];
-    _mm_store_ps(r4, sr), _mm_store_ps(g4, sg), _mm_store_ps(b4, sb);
-    glm::vec3 E(r4[0] + r4[1] + r4[2] + r4[3], g4[0] + g4[1] + g4[2] + g4[3], b4[0] + b4[1] + b4[2] + b4[3]);
-    // Near clusters by their children, and near children by their triangles: each a
-    // point, or, when the receiver is within a few of its radii, its exact form factor
-    // (E = L π F).
-    for (std::uint32_t k : near) {
-      const SurfaceCluster& c = clusters[k];
-      float sum = 0;
-      for (std::uint32_t j = c.first_child; j < c.first_child + c.child_count; ++j) {
-        const SurfaceCluster& patch = o.surface.children[j];
-        const glm::vec3 d = glm::vec3(Tf * glm::vec4(patch.centre, 1.0f)) - x;
-        const float r2 = glm::dot(d, d);
-        if (r2 >= near_radii2 * patch.radius * patch.radius) {
-          sum += patch.area * area_scale * std::max(glm::dot(d, nrm), 0.0f) *
-                 std::max(-glm::dot(d, rotate * patch.normal), 0.0f) / (r2 * r2 + 1e-30f);
-          continue;
-        }
-        for (std::uint32_t q = patch.first; q < patch.first + patch.count; ++q) {
-          const std::uint32_t t = order[q];
-          const glm::vec3 dt = triangle_centre[t] - x;
-          const float cos_t = -glm::dot(dt, triangle_facing[t]);
-          if (cos_t <= 0) continue;  // turned away: a closed surface shows its front
-          const float rt2 = glm::dot(dt, dt);
-          if (rt2 >= near_radii2 * o.triangle_radius[t] * o.triangle_radius[t]) {
-            sum += o.triangle_area[t] * area_scale * std::max(glm::dot(dt, nrm), 0.0f) * cos_t / (rt2 * rt2);
-          } else {
-            const auto corner_from_x = [&](int k) {
-              return glm::vec3(Tf * glm::vec4(m.positions[m.indices[3 * t + std::uint32_t(k)]], 1.0f)) - x;
-            };
-            sum += float(kPi) * triangle_form_factor(nrm, corner_from_x(0), corner_from_x(1), corner_from_x(2));
+  // Receivers apart, each writing its own sum: the same result on any number of threads.
+  struct Counts {
+    std::size_t pairs = 0, near_pairs = 0;
+  };
+  tbb::combinable<Counts> counts;
+  tbb::parallel_for(
+      tbb::blocked_range<std::size_t>(0, positions.size(), 16),
+      [&](const auto& range) {
+        Counts& count = counts.local();
+        std::vector<std::uint32_t> near;
+        for (std::size_t i = range.begin(); i < range.end(); ++i) {
+          const glm::vec3 x = positions[i], nrm = normals[i];
+          if (glm::length(x - middle) > reach) continue;
+          near.clear();
+          // Far clusters as points, four at a time: A cos θ_c cos θ_x / r², the cosines being
+          // dot products over r, both clamped at 0 (facing is the visibility).
+          const __m128 xx = _mm_set1_ps(x.x), xy = _mm_set1_ps(x.y), xz = _mm_set1_ps(x.z);
+          const __m128 mx = _mm_set1_ps(nrm.x), my = _mm_set1_ps(nrm.y), mz = _mm_set1_ps(nrm.z);
+          const __m128 zero = _mm_setzero_ps(), tiny = _mm_set1_ps(1e-30f);
+          __m128 sr = zero, sg = zero, sb = zero;
+          for (std::size_t k = 0; k < padded; k += 4) {
+            const __m128 dx = _mm_sub_ps(_mm_loadu_ps(&px[k]), xx), dy = _mm_sub_ps(_mm_loadu_ps(&py[k]), xy),
+                         dz = _mm_sub_ps(_mm_loadu_ps(&pz[k]), xz);
+            const __m128 r2 = _mm_add_ps(_mm_add_ps(_mm_mul_ps(dx, dx), _mm_mul_ps(dy, dy)), _mm_mul_ps(dz, dz));
+            const __m128 cos_x = _mm_add_ps(_mm_add_ps(_mm_mul_ps(dx, mx), _mm_mul_ps(dy, my)), _mm_mul_ps(dz, mz));
+            const __m128 cos_c =
+                _mm_add_ps(_mm_add_ps(_mm_mul_ps(dx, _mm_loadu_ps(&nx[k])), _mm_mul_ps(dy, _mm_loadu_ps(&ny[k]))),
+                           _mm_mul_ps(dz, _mm_loadu_ps(&nz[k])));
+            const __m128 is_near = _mm_cmplt_ps(r2, _mm_loadu_ps(&near2[k]));
+            if (const int bits = _mm_movemask_ps(is_near))
+              for (int j = 0; j < 4; ++j)
+                if (bits & (1 << j)) near.push_back(std::uint32_t(k) + std::uint32_t(j));
+            // cos_c is the outgoing cosine's negative (d points from the receiver to the cluster).
+            const __m128 g = _mm_andnot_ps(
+                is_near, _mm_div_ps(_mm_mul_ps(_mm_max_ps(cos_x, zero), _mm_max_ps(_mm_sub_ps(zero, cos_c), zero)),
+                                    _mm_add_ps(_mm_mul_ps(r2, r2), tiny)));
+            sr = _mm_add_ps(sr, _mm_mul_ps(g, _mm_loadu_ps(&fr[k])));
+            sg = _mm_add_ps(sg, _mm_mul_ps(g, _mm_loadu_ps(&fg[k])));
+            sb = _mm_add_ps(sb, _mm_mul_ps(g, _mm_loadu_ps(&fb[k])));
           }
+          alignas(16) float r4[4], g4[4], b4[4];
+          _mm_store_ps(r4, sr), _mm_store_ps(g4, sg), _mm_store_ps(b4, sb);
+          glm::vec3 E(r4[0] + r4[1] + r4[2] + r4[3], g4[0] + g4[1] + g4[2] + g4[3], b4[0] + b4[1] + b4[2] + b4[3]);
+          // Near clusters by their children, and near children by their triangles: each a
+          // point, or, when the receiver is within a few of its radii, its exact form factor
+          // (E = L π F).
+          for (std::uint32_t k : near) {
+            const SurfaceCluster& c = clusters[k];
+            float sum = 0;
+            for (std::uint32_t j = c.first_child; j < c.first_child + c.child_count; ++j) {
+              const SurfaceCluster& patch = o.surface.children[j];
+              const glm::vec3 d = glm::vec3(Tf * glm::vec4(patch.centre, 1.0f)) - x;
+              const float r2 = glm::dot(d, d);
+              if (r2 >= near_radii2 * patch.radius * patch.radius) {
+                sum += patch.area * area_scale * std::max(glm::dot(d, nrm), 0.0f) *
+                       std::max(-glm::dot(d, rotate * patch.normal), 0.0f) / (r2 * r2 + 1e-30f);
+                continue;
+              }
+              for (std::uint32_t q = patch.first; q < patch.first + patch.count; ++q) {
+                const std::uint32_t t = order[q];
+                const glm::vec3 dt = triangle_centre[t] - x;
+                const float cos_t = -glm::dot(dt, triangle_facing[t]);
+                if (cos_t <= 0) continue;  // turned away: a closed surface shows its front
+                const float rt2 = glm::dot(dt, dt);
+                if (rt2 >= near_radii2 * o.triangle_radius[t] * o.triangle_radius[t]) {
+                  sum += o.triangle_area[t] * area_scale * std::max(glm::dot(dt, nrm), 0.0f) * cos_t / (rt2 * rt2);
+                } else {
+                  const auto corner_from_x = [&](int k) {
+                    return glm::vec3(Tf * glm::vec4(m.positions[m.indices[3 * t + std::uint32_t(k)]], 1.0f)) - x;
+                  };
+                  sum += float(kPi) * triangle_form_factor(nrm, corner_from_x(0), corner_from_x(1), corner_from_x(2));
+                }
+              }
+            }
+            E += sum * radiance[k];
+          }
+          out[i] += E;
+          count.pairs += n - near.size();
+          count.near_pairs += near.size();
         }
-      }
-      E += sum * radiance[k];
-    }
-    out[i] += E;
-    stats_.pairs += n - near.size();
-    stats_.near_pairs += near.size();
-  }
+      },
+      tbb::simple_partitioner());
+  counts.combine_each([&](const Counts& c) {
+    stats_.pairs += c.pairs;
+    stats_.near_pairs += c.near_pairs;
+  });
 }
 
 ObjectBounce::Irradiance object_irradiance(const IrradianceVolume* volume, const SH9& sh) {

@@ -22,6 +22,22 @@
 
 namespace lumar::pipeline {
 
+// The knobs that trade a frame's time for its accuracy (docs/results.md, "Quality
+// knobs"); the defaults are full quality. `--quality auto` picks them per recording
+// (quality_choice.h).
+struct OverlayQuality {
+  ObjectShading shading = ObjectShading::PerPixel;  // the volume's light per pixel or per vertex
+  ShadowQuality shadows;                            // lines per receiver and emitter patch (docs/shadows.md)
+  // The exact lights the irradiance volume evaluates with shadow maps, instead of the
+  // manifest's lighting.irradiance.max_lights (0 to 16), and the texels per side of their
+  // shadow maps, instead of its shadow_map_resolution (8 to 1024); the volume is built, or
+  // taken from the cache, for them.
+  std::optional<int> exact_lights, shadow_map;
+  bool operator==(const OverlayQuality&) const = default;
+  // "vertex, 4 lines, 6 lights, 64 px shadow maps" (unset counts as "manifest's").
+  std::string describe() const;
+};
+
 struct OverlaySettings {
   calib::UndistortedCamera undistortion = calib::UndistortedCamera::SameMatrix;
   // > 0: every that many frames, compare the video with the map and follow the room's
@@ -39,12 +55,7 @@ struct OverlaySettings {
   // calib/camera_blur.h) unless blur_sigma_px >= 0 gives the blur.
   gl::CompositeFeatures features;
   double blur_sigma_px = -1.0;
-  ObjectShading shading = ObjectShading::PerPixel;  // the volume's light per pixel or per vertex
-  ShadowQuality shadow_quality;                     // lines per receiver and emitter patch (docs/shadows.md)
-  // The exact lights the irradiance volume evaluates with shadow maps, instead of the
-  // manifest's lighting.irradiance.max_lights (0 to 16; the volume is built, or taken
-  // from the cache, for that count).
-  std::optional<int> exact_lights;
+  OverlayQuality quality;
   // Animated objects (the manifest's paths) play in recording time; live, from the first
   // frame the overlay sees.
   bool live = false;
@@ -89,10 +100,24 @@ class Overlay {
   // Only the first step of composite(): the animated objects where their paths are then.
   void play_paths(Nanos frame_time);
 
+  // composite() in two halves for a pipelined replay: prepare() moves the animated
+  // objects and works out their shadows and light (Compositor::prepare: no GL, so on
+  // another thread, a frame or two ahead), render() draws the frame with them on the
+  // thread that holds the GL context. Only while can_prepare_ahead(): the lighting
+  // adaptation changes the light between frames on the GL thread.
+  bool can_prepare_ahead() const { return !live_lighting_; }
+  FrameLight prepare(Nanos frame_time);
+  OverlayFrame render(const capture::Frame& frame, const std::optional<Pose>& T_world_camera, const FrameLight& light);
+
   // Swaps in another scene (objects added or removed, another lighting method): a new
-  // compositor with this one's features, shadow switch and measured camera; the
-  // irradiance volume comes from the cache when its inputs are unchanged.
+  // compositor with this one's features, quality and measured camera; the irradiance
+  // volume comes from the cache when its inputs are unchanged.
   void set_scene(std::shared_ptr<const LoadedScene> scene);
+  // Another exact-light count or shadow-map size makes a new compositor (as set_scene);
+  // the other knobs are the compositor's own. InputError for a count out of range.
+  void set_quality(const OverlayQuality& quality);
+  // The knobs now (the window's panel may change the shadow lines on the compositor).
+  OverlayQuality quality() const;
   // > 0: every that many frames, compare the video with the map and follow the room's
   // lighting (OverlaySettings::adapt_lighting_every); 0: off, back to the map's light.
   void set_adapt_lighting_every(int every_n_frames);
@@ -114,6 +139,11 @@ class Overlay {
   const LoadedScene& scene() const { return compositor_->scene(); }
   gl::WindowContext* window() { return window_; }
   StageTimes& times() { return times_; }  // composite() fills the rendering stages; callers the rest
+  // Clears the stage times and the first composite's time (after frames that were not the run's).
+  void reset_times() {
+    times_ = {};
+    first_composite_.reset();
+  }
   // When the first frame's composite was ready (steady clock); nullopt before it.
   std::optional<std::chrono::steady_clock::time_point> first_composite_time() const { return first_composite_; }
   const StageTimes& times() const { return times_; }
@@ -127,6 +157,9 @@ class Overlay {
   static constexpr double kClipWarnShare = 0.05;
   std::optional<double> objects_clipped() const { return objects_clipped_; }
   const LiveLighting* live_lighting() const { return live_lighting_ ? &*live_lighting_ : nullptr; }
+  // How the video's codes map to linear light, and to the composite's geometry.
+  const calib::CameraResponse& response() const { return response_; }
+  const calib::UndistortionMaps& undistortion() const { return maps_; }
   // The video's radiometry as the renderer has it now (noise and blur once measured).
   const gl::VideoRadiometry& video_radiometry() const { return radiometry_; }
 
@@ -147,7 +180,8 @@ class Overlay {
   bool noise_known_ = false, blur_known_ = false, warned_ = false;
   std::int64_t frames_seen_ = 0;
   bool live_ = false, volume_cache_ = true;
-  std::optional<int> exact_lights_;
+  OverlayQuality quality_;
+  std::shared_ptr<const LoadedScene> scene_;  // as given, before the quality's volume knobs
   std::optional<Nanos> first_frame_time_;
   StageTimes times_;
   std::optional<std::chrono::steady_clock::time_point> first_composite_;
@@ -156,13 +190,22 @@ class Overlay {
   int frames_since_clip_check_ = kClipCheckEvery;
   bool clip_warned_ = false;
   void measure_clipping(const cv::Mat& composite, const Pose& T_world_camera);
+  // Where the paths put the animated objects at frame_time: on the compositor and its
+  // renderer, or (prepare) on the compositor's CPU side alone.
+  void move_along_paths(Nanos frame_time, bool renderer_too);
+  // composite()'s and render()'s common start (the frame's fields, the camera measured)
+  // and end (the objects drawn, the times kept).
+  OverlayFrame begin(const capture::Frame& frame, const std::optional<Pose>& T_world_camera);
+  void draw(OverlayFrame& out, const capture::Frame& frame, const FrameLight& light);
 };
 
 // One line per stage: mean milliseconds per frame and share of the total.
 std::string format_stage_times(const StageTimes& t);
 // The run's figures as JSON (docs/formats.md, "Overlay stats"): frames, fps (frames over
 // `wall_seconds`), latency_ms_mean, startup_ms (from the command's start to its first
-// composite; negative: none, written as null), and stages (name -> mean ms per frame).
-std::string stage_times_json(const StageTimes& t, double wall_seconds, double startup_ms = -1);
+// composite; negative: none, written as null), quality (the knobs, OverlayQuality::describe;
+// empty: null) and stages (name -> mean ms per frame).
+std::string stage_times_json(const StageTimes& t, double wall_seconds, double startup_ms = -1,
+                             const std::string& quality = "");
 
 }  // namespace lumar::pipeline

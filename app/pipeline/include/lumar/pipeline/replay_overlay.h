@@ -11,6 +11,7 @@
 #include "lumar/capture/recording_replay.h"
 #include "lumar/pipeline/image_aided_pose.h"
 #include "lumar/pipeline/overlay.h"
+#include "lumar/pipeline/quality_choice.h"
 #include "lumar/scene/loaded_scene.h"
 #include "lumar/tracking/one_euro_filter.h"
 
@@ -26,6 +27,9 @@ struct ReplayOverlaySettings {
   std::optional<tracking::PoseFilterSettings> filter;  // on the tracker's samples (not on the truth)
   ImageAidedSettings image_aided;                      // for PoseSource::Fused
   OverlaySettings overlay;
+  // Set: the quality knobs chosen on the recording's own frames before the run, from
+  // overlay.quality as full quality (quality_choice.h).
+  std::optional<QualityBudget> auto_quality;
   // Replay a recording whose writer never closed it (killed, crashed, disk full): its
   // closed segments are whole, but it may end early. Refused by default.
   bool allow_incomplete = false;
@@ -60,6 +64,12 @@ class ReplayOverlay {
   // opened from replay() before are stale afterwards: open them again.
   void set_pose_filter(const std::optional<tracking::PoseFilterSettings>& filter);
 
+  // `count` frames spread evenly over the recording (each the first at or after its place
+  // that has a camera pose), for choose_quality.
+  std::vector<ProbeFrame> probe_frames(int count);
+  // What ReplayOverlaySettings::auto_quality chose (nullopt: not asked for).
+  const std::optional<QualityChoice>& quality_choice() const { return quality_choice_; }
+
   const capture::RecordingReplay& replay() const { return replay_; }
   Overlay& overlay() { return *overlay_; }
   const LoadedScene& scene() const { return overlay_->scene(); }
@@ -77,6 +87,7 @@ class ReplayOverlay {
   std::unique_ptr<Overlay> overlay_;
   ImageAidedSettings image_aided_;
   std::unique_ptr<ImageAidedPose> fused_;  // while the source is Fused
+  std::optional<QualityChoice> quality_choice_;
 };
 
 }  // namespace lumar::pipeline

@@ -13,7 +13,8 @@ namespace lumar::pipeline {
 
 struct TruthComparison {
   CompositeError error;
-  double ms_per_frame = 0;  // the overlay's stages (decode to read-back), mean per frame after the first
+  double ms_per_frame = 0;               // the overlay's stages (decode to read-back), mean per frame after the first
+  std::optional<QualityChoice> quality;  // what settings.auto_quality chose, if asked
 };
 
 // Each composite frame with its truth and the truth's object mask, undistorted like it

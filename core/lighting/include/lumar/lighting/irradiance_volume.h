@@ -33,6 +33,7 @@ struct VolumeSettings {
   ProbeStorage storage = ProbeStorage::sh9_octahedral;
   int octahedral_resolution = 12;  // texels per side of the octahedral map
   bool separate_lights = true;     // dominant lights evaluated per pixel (shadow maps), not stored
+  int shadow_map_resolution = 128;  // texels per side of each exact light's shadow map: ~1.4 degrees at 128
   int rays_per_probe = 512;        // for the radiance below the bright threshold
   int depth_resolution = 8;        // distance-moment texels per side
   double spacing = 0.3;            // largest cell edge of the uniform level, metres
@@ -48,6 +49,9 @@ struct VolumeSettings {
 // "greger2004" (64 rays per probe, no bright texels, no visibility, bilevel grid).
 // Throws InputError for another name.
 VolumeSettings volume_settings_for(const std::string& method);
+
+// The most exact lights the renderer's shader evaluates (its arrays' size).
+inline constexpr int kMaxExactLights = 16;
 
 // A dominant light as the volume evaluates it at a shading point.
 struct VolumeLight {

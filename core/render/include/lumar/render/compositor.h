@@ -38,6 +38,19 @@ struct ShadowQuality {
 // both are the same.
 enum class ObjectShading { PerPixel, PerVertex };
 
+// The CPU's part of a frame, worked out by Compositor::prepare without GL: the objects'
+// poses, and what of their shadows, bounce and per-vertex light changed since the frame
+// before (empty or unset: unchanged). A pipelined replay prepares a frame on another
+// thread while the one before is drawn; render() uploads it on the GL thread.
+struct FrameLight {
+  std::vector<glm::dmat4> poses;                                         // T_world_model per object
+  std::optional<std::vector<glm::vec3>> receiver_attenuation;            // shadow and bounce, per receiver
+  std::vector<std::vector<glm::vec3>> object_bounce;                     // per object: the others' light on it
+  std::vector<std::vector<glm::vec3>> object_shadowing;                  // per object: the others' shadow on it
+  std::vector<std::optional<std::vector<glm::vec3>>> vertex_irradiance;  // per object (ObjectShading::PerVertex)
+  double shadows_ms = 0, vertex_light_ms = 0;
+};
+
 class Compositor {
  public:
   // `output_camera`: the undistorted camera the renderer draws with. `map_x`, `map_y`:
@@ -51,12 +64,22 @@ class Compositor {
 
   // Composites one BGR8 video frame seen from T_world_camera (nullopt: no pose, the
   // undistorted video alone); `exposure` is the video's linear value per unit of scene radiance.
+  // It is render(prepare(), ...).
   cv::Mat composite(const cv::Mat& video_bgr8, const std::optional<Pose>& T_world_camera, double exposure,
                     gl::OverlayTimings* timings = nullptr);
+  // The two halves of composite(). prepare() touches no GL and may run on another thread
+  // than render(), one frame or two ahead, provided nothing else changes this compositor
+  // meanwhile; the frames must be rendered in the order they were prepared.
+  FrameLight prepare();
+  cv::Mat render(const FrameLight& light, const cv::Mat& video_bgr8, const std::optional<Pose>& T_world_camera,
+                 double exposure, gl::OverlayTimings* timings = nullptr);
 
   // Moves object `index` (manifest order): the renderer and the shadow lines follow; the
   // shadows are recomputed in the next composite() only if a pose changed.
   void set_object_pose(std::size_t index, const glm::dmat4& T_world_model);
+  // The same for prepare() alone: the renderer takes the pose from the next FrameLight
+  // it renders (no GL here).
+  void move_object(std::size_t index, const glm::dmat4& T_world_model);
   const glm::dmat4& object_pose(std::size_t index) const { return poses_.at(index); }
   // The object's diffuse albedo: its shading and the light it reflects onto the room.
   void set_object_albedo(std::size_t index, const glm::vec3& albedo);
@@ -129,10 +152,10 @@ class Compositor {
   ShadowQuality shadow_quality_;
   MapCellScale light_scale_;  // the room's change since the map was captured (set_lighting)
   void relight_shadows();
-  void upload_object_bounce(bool on);
+  std::vector<std::vector<glm::vec3>> object_bounce(bool on) const;
   ObjectShading shading_ = ObjectShading::PerPixel;
   std::vector<char> vertex_light_stale_;  // per object: moved, or the light changed, since lit
-  void light_vertices();
+  void light_vertices(FrameLight& light);
   bool shadows_enabled_ = true, object_shadows_enabled_ = true, shadows_uploaded_ = false,
        object_shadows_uploaded_ = false;
 };

@@ -77,7 +77,7 @@ struct LightingSettings {
   std::string method = "volume";  // one of kLightingMethods
   // "irradiance": the volume's quality knobs; those not given keep the method's defaults.
   std::optional<double> spacing;
-  std::optional<int> rays_per_probe, octahedral_resolution, max_lights;
+  std::optional<int> rays_per_probe, octahedral_resolution, max_lights, shadow_map_resolution;
   std::optional<bool> refine, visibility;
 };
 // volume: the irradiance volume (SH9 + an octahedral correction + exact dominant lights);

@@ -72,7 +72,7 @@ struct BounceStats {
   std::size_t receivers_reached = 0;  // receivers within reach of at least one object
   std::size_t pairs = 0;              // (receiver or vertex, cluster) pairs summed as points
   std::size_t near_pairs = 0;         // (receiver or vertex, cluster) pairs summed triangle by triangle
-  double ms = 0;                      // wall time of the update (one thread)
+  double ms = 0;                      // wall time of the update
   double onto_objects_ms = 0;         // of which onto each other's vertices
 };
 
@@ -132,11 +132,15 @@ class ObjectBounce {
     std::vector<glm::vec3> triangle_centre, triangle_facing;
     std::vector<float> triangle_area, triangle_radius;
     std::vector<glm::vec3> received;  // per vertex: what the other objects reflect onto it
+    // Per cluster, in its current pose: albedo/π × open × E(bent normal) × open, the
+    // radiance that leaves past the object (light_clusters).
+    std::vector<glm::vec3> cluster_radiance;
   };
   static void shade_clusters(Object& o, std::span<const VertexOcclusion> occlusion);
+  static void light_clusters(Object& o, const Irradiance& irradiance);
   // Adds what `o` reflects onto the points (world, unit normals) into `out`.
-  void add_object_bounce(const Object& o, const Irradiance& irradiance, std::span<const glm::vec3> positions,
-                         std::span<const glm::vec3> normals, std::span<glm::vec3> out);
+  void add_object_bounce(const Object& o, std::span<const glm::vec3> positions, std::span<const glm::vec3> normals,
+                         std::span<glm::vec3> out);
 
   std::vector<glm::vec3> positions_, normals_, unshadowed_;
   BounceSettings settings_;
