@@ -74,6 +74,32 @@ TEST(PipelinedReplay, MovingObjectsPreparedAheadGiveTheSerialFrames) {
   }
 }
 
+// A run stopped by its sink drops frames that were prepared ahead but never drawn
+// (ReplayOverlay::run then calls Compositor::forget_prepared): their shadows and light
+// must not be taken for uploaded. Frame 1 prepared and dropped, then composited: what a
+// fresh overlay gives for frame 1 (without forgetting, frame 0's shadows and light stay).
+TEST(PipelinedReplay, FramesPreparedAndDroppedAreNotTakenForDrawn) {
+  pipeline::ReplayOverlaySettings s = settings();
+  s.overlay.quality.shading = ObjectShading::PerVertex;
+  pipeline::ReplayOverlay dropped(test::source_dir() / "recordings/walk", s),
+      fresh(test::source_dir() / "recordings/walk", s);
+  std::vector<capture::Frame> frames(2);
+  auto source = fresh.replay().open_frames();
+  for (capture::Frame& f : frames) {
+    ASSERT_TRUE(source->read(f));
+    f.image = f.image.clone();
+  }
+  const auto composite = [&](pipeline::ReplayOverlay& o, const capture::Frame& f) {
+    return o.overlay().composite(f, o.camera_pose(f)).composite;
+  };
+  composite(dropped, frames[0]);
+  dropped.overlay().prepare(frames[1].time);  // handed to no one
+  dropped.compositor().forget_prepared();
+  composite(fresh, frames[0]);
+  const cv::Mat want = composite(fresh, frames[1]);
+  EXPECT_EQ(cv::norm(composite(dropped, frames[1]), want, cv::NORM_INF), 0.0);
+}
+
 // Lighting adaptation changes the light on the GL thread between frames: nothing is
 // prepared ahead then, and the pipelined run composites each frame whole.
 TEST(PipelinedReplay, WithTheLightingAdaptedNothingIsPreparedAhead) {

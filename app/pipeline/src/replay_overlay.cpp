@@ -202,6 +202,8 @@ void ReplayOverlay::run_pipelined(int max_frames, const std::function<bool(const
   decoder.join();
   preparer.join();
   writer.join();
+  // A frame prepared ahead may have been dropped when the run stopped.
+  if (ahead) overlay_->compositor().forget_prepared();
   times.output += output_ms;
   times.latency += latency_ms;
   for (const std::exception_ptr& e : {composite_error, prepare_error, sink_error, decode_error})

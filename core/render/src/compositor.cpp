@@ -4,6 +4,7 @@
 
 #include <tbb/task_group.h>
 
+#include <algorithm>
 #include <chrono>
 
 #include "lumar/base/error.h"
@@ -297,6 +298,11 @@ FrameLight Compositor::prepare() {
   light.shadows_ms = std::chrono::duration<double, std::milli>(t1 - t0).count();
   light.vertex_light_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t1).count();
   return light;
+}
+
+void Compositor::forget_prepared() {
+  shadows_uploaded_ = object_shadows_uploaded_ = false;
+  std::fill(vertex_light_stale_.begin(), vertex_light_stale_.end(), 1);
 }
 
 cv::Mat Compositor::render(const FrameLight& light, const cv::Mat& video_bgr8,

@@ -73,6 +73,9 @@ class Compositor {
   FrameLight prepare();
   cv::Mat render(const FrameLight& light, const cv::Mat& video_bgr8, const std::optional<Pose>& T_world_camera,
                  double exposure, gl::OverlayTimings* timings = nullptr);
+  // Frames were prepared and never rendered (a pipelined run stopped): the next prepare()
+  // hands on everything again, not only what changed since.
+  void forget_prepared();
 
   // Moves object `index` (manifest order): the renderer and the shadow lines follow; the
   // shadows are recomputed in the next composite() only if a pose changed.
