@@ -74,8 +74,9 @@ void apply_composite_options(const CompositeOptions& o, pipeline::OverlaySetting
     throw InputError("--shading " + o.shading + ": use pixel or vertex");
   pipeline::OverlayQuality& q = settings.quality;
   q.shading = o.shading == "vertex" ? ObjectShading::PerVertex : ObjectShading::PerPixel;
-  if (o.shadow_lines < 1 || o.shadow_lines > 64)
-    throw InputError("--shadow-lines " + std::to_string(o.shadow_lines) + ": use 1 to 64 lines per patch");
+  if (o.shadow_lines < 1 || o.shadow_lines > ShadowQuality::kMaxLinesPerPatch)
+    throw InputError(fmt::format("--shadow-lines {}: use 1 to {} lines per patch", o.shadow_lines,
+                                 ShadowQuality::kMaxLinesPerPatch));
   q.shadows.lines_per_patch = o.shadow_lines;
   if (o.exact_lights != -1) {
     if (o.exact_lights < 0 || o.exact_lights > kMaxExactLights)
@@ -83,8 +84,9 @@ void apply_composite_options(const CompositeOptions& o, pipeline::OverlaySetting
     q.exact_lights = o.exact_lights;
   }
   if (o.shadow_map != -1) {
-    if (o.shadow_map < 8 || o.shadow_map > 1024)
-      throw InputError(fmt::format("--shadow-map {}: use 8 to 1024 texels per side", o.shadow_map));
+    if (o.shadow_map < kMinShadowMapResolution || o.shadow_map > kMaxShadowMapResolution)
+      throw InputError(fmt::format("--shadow-map {}: use {} to {} texels per side", o.shadow_map,
+                                   kMinShadowMapResolution, kMaxShadowMapResolution));
     q.shadow_map = o.shadow_map;
   }
 }

@@ -50,10 +50,12 @@ std::shared_ptr<const LoadedScene> with_volume_knobs(std::shared_ptr<const Loade
 void check_quality(const OverlayQuality& q) {
   if (q.exact_lights && (*q.exact_lights < 0 || *q.exact_lights > kMaxExactLights))
     throw InputError(fmt::format("exact lights: {}; use 0 to {}", *q.exact_lights, kMaxExactLights));
-  if (q.shadow_map && (*q.shadow_map < 8 || *q.shadow_map > 1024))
-    throw InputError(fmt::format("shadow maps of {} texels per side; use 8 to 1024", *q.shadow_map));
-  if (q.shadows.lines_per_patch < 1 || q.shadows.lines_per_patch > 64)
-    throw InputError(fmt::format("{} shadow lines per patch; use 1 to 64", q.shadows.lines_per_patch));
+  if (q.shadow_map && (*q.shadow_map < kMinShadowMapResolution || *q.shadow_map > kMaxShadowMapResolution))
+    throw InputError(fmt::format("shadow maps of {} texels per side; use {} to {}", *q.shadow_map,
+                                 kMinShadowMapResolution, kMaxShadowMapResolution));
+  if (q.shadows.lines_per_patch < 1 || q.shadows.lines_per_patch > ShadowQuality::kMaxLinesPerPatch)
+    throw InputError(fmt::format("{} shadow lines per patch; use 1 to {}", q.shadows.lines_per_patch,
+                                 ShadowQuality::kMaxLinesPerPatch));
 }
 }  // namespace
 

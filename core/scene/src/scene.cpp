@@ -292,7 +292,7 @@ LightingSettings read_lighting(const ManifestReader& r, const json& doc) {
   out.rays_per_probe = integer("rays_per_probe", 16, 65536);
   out.octahedral_resolution = integer("octahedral_resolution", 2, 64);
   out.max_lights = integer("max_lights", 0, 32);
-  out.shadow_map_resolution = integer("shadow_map_resolution", 8, 1024);
+  out.shadow_map_resolution = integer("shadow_map_resolution", kMinShadowMapResolution, kMaxShadowMapResolution);
   if (q.contains("refine")) out.refine = r.boolean_or(q, k, "refine", true);
   if (q.contains("visibility")) out.visibility = r.boolean_or(q, k, "visibility", true);
   return out;

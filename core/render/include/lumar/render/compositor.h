@@ -25,6 +25,7 @@ struct VertexOcclusion;
 // into, and how many sample points (line ends) each patch has, so lines per receiver and
 // patch.
 struct ShadowQuality {
+  static constexpr int kMaxLinesPerPatch = 64;  // what the overlay's knob allows
   int emitter_patches = 64;
   int lines_per_patch = 8;
   bool operator==(const ShadowQuality&) const = default;

@@ -72,6 +72,10 @@ struct ShadowRegions {
   int receiver_vertices = 3200;     // about this many receiver vertices, spread uniformly
 };
 
+// The bounds of lighting.irradiance.shadow_map_resolution, texels per side (also the
+// overlay's --shadow-map).
+inline constexpr int kMinShadowMapResolution = 8, kMaxShadowMapResolution = 1024;
+
 // The manifest's "lighting": how the virtual objects are shaded (docs/irradiance.md).
 struct LightingSettings {
   std::string method = "volume";  // one of kLightingMethods
