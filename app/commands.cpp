@@ -46,6 +46,11 @@ void add_composite_options(CLI::App* cmd, CompositeOptions& o) {
   cmd->add_option("--shadow-map", o.shadow_map,
                   "Texels per side of each exact light's shadow map (8 to 1024; default: the manifest's "
                   "lighting.irradiance.shadow_map_resolution, else 128)");
+  cmd->add_option("--coverage-mesh", o.coverage_mesh_px,
+                  "Antialiasing: find the objects' coverage of each pixel from their coarsest simplified meshes "
+                  "whose surface stays within this many output pixels of the mesh (0: the meshes as given; up to 8; "
+                  "docs/results.md)")
+      ->capture_default_str();
 }
 
 void apply_composite_options(const CompositeOptions& o, pipeline::OverlaySettings& settings) {
@@ -89,6 +94,10 @@ void apply_composite_options(const CompositeOptions& o, pipeline::OverlaySetting
                                    kMinShadowMapResolution, kMaxShadowMapResolution));
     q.shadow_map = o.shadow_map;
   }
+  if (!(o.coverage_mesh_px >= 0.0 && o.coverage_mesh_px <= gl::Renderer::kMaxCoverageErrorPx))
+    throw InputError(fmt::format("--coverage-mesh {}: use 0 (the meshes as given) to {} pixels", o.coverage_mesh_px,
+                                 gl::Renderer::kMaxCoverageErrorPx));
+  q.coverage_mesh_px = o.coverage_mesh_px;
 }
 
 std::optional<pipeline::QualityBudget> auto_quality(const CompositeOptions& o) {

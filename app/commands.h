@@ -35,6 +35,7 @@ struct CompositeOptions {
   int shadow_lines = ShadowQuality{}.lines_per_patch;
   int exact_lights = -1;  // -1: the manifest's
   int shadow_map = -1;    // -1: the manifest's
+  double coverage_mesh_px = pipeline::OverlayQuality{}.coverage_mesh_px;
   std::string quality = "full";
   double quality_budget = pipeline::QualityBudget{}.percent;
 };

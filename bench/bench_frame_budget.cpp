@@ -1,14 +1,15 @@
 // The quality knobs of the overlay against its composite error and time per frame
 // (issue 19; pipeline::OverlayQuality): where the objects are lit (per pixel or per
 // vertex), the shadow lines per receiver and emitter patch, the number of exact lights the
-// volume evaluates with shadow maps, and those maps' size. On a synthetic recording of
-// the walk scene with its truth (the figurines move, so their shadows and light are
-// traced again every frame), through the pipeline library `lumar regress` runs.
-// Baseline: full quality (per pixel, 8 lines, 16 lights, 128 px maps) in the same run.
-// Then `--quality auto` (quality_choice.h), which chooses without the truth, is run the
-// same way: its errors against the truth must stay within 1.2 x full quality's.
-// "best" marks the cheapest grid setting within that bound, for comparison.
-// Writes docs/composite_error_vs_frame_time.png.
+// volume evaluates with shadow maps, those maps' size, and how far (pixels) the simplified
+// meshes the antialiasing takes the objects' coverage from may be from the objects'. On a
+// synthetic recording of the walk scene with its truth (the figurines move, so their
+// shadows and light are traced again every frame), through the pipeline library `lumar
+// regress` runs. Baseline: full quality (per pixel, 8 lines, 16 lights, 128 px maps, 1 px
+// coverage meshes, the defaults) in the same run. Then `--quality auto`
+// (quality_choice.h), which chooses without the truth, is run the same way: its errors
+// against the truth must stay within 1.2 x full quality's. "best" marks the cheapest grid
+// setting within that bound, for comparison. Writes docs/composite_error_vs_frame_time.png.
 #include <spdlog/spdlog.h>
 #include <unistd.h>
 
@@ -28,9 +29,11 @@ const fs::path kScene = kSource / "data/scenes/room/walk.json";
 struct Knobs {
   bool vertex = false;
   int lines = 8, lights = 16, map = 128;
+  double coverage_px = 1.0;
   std::string name() const {
-    return fmt::format("{}, {} lines, {} lights{}", vertex ? "vertex" : "pixel", lines, lights,
-                       map == 128 ? "" : fmt::format(", {} px maps", map));
+    return fmt::format("{}, {} lines, {} lights{}{}", vertex ? "vertex" : "pixel", lines, lights,
+                       map == 128 ? "" : fmt::format(", {} px maps", map),
+                       coverage_px == 1.0 ? "" : fmt::format(", {:g} px coverage", coverage_px));
   }
 };
 
@@ -53,7 +56,8 @@ int main() {
   for (int lights : {16, 6, 2})
     for (bool vertex : {false, true})
       for (int lines : {8, 4, 2}) settings.push_back({vertex, lines, lights});
-  for (int map : {64, 32}) settings.push_back({false, 8, 16, map});  // the maps' size alone
+  for (int map : {64, 32}) settings.push_back({false, 8, 16, map});               // the maps' size alone
+  for (double px : {0.0, 2.0, 4.0}) settings.push_back({false, 8, 16, 128, px});  // the coverage meshes alone
   std::vector<std::array<double, 3>> errors;
   std::vector<double> ms;
   for (const Knobs& knobs : settings) {
@@ -62,6 +66,7 @@ int main() {
     s.overlay.quality.shading = knobs.vertex ? ObjectShading::PerVertex : ObjectShading::PerPixel;
     s.overlay.quality.shadows.lines_per_patch = knobs.lines;
     s.overlay.quality.shadow_map = knobs.map;
+    s.overlay.quality.coverage_mesh_px = knobs.coverage_px;
     const auto compared = pipeline::compare_with_truth(synth.out, s);
     const pipeline::CompositeError& e = compared->error;
     errors.push_back({e.object_err, e.edge_err, e.shadow_err});

@@ -154,6 +154,7 @@ PY
   expect_bad_input "--quality-budget" "$TMP/bad" -- "$LUMAR" overlay --recording "$REC" --quality auto \
     --quality-budget 0 --frames-dir "$TMP/bad"
   expect_bad_input "--shadow-map" "$TMP/bad" -- "$LUMAR" overlay --recording "$REC" --shadow-map 4 --frames-dir "$TMP/bad"
+  expect_bad_input "--coverage-mesh" "$TMP/bad" -- "$LUMAR" overlay --recording "$REC" --coverage-mesh 9 --frames-dir "$TMP/bad"
   expect_bad_input "--quality auto" "$TMP/bad" -- "$LUMAR" overlay --source "images:$TMP/none" --quality auto \
     --frames-dir "$TMP/bad"
 }

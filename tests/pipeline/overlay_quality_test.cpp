@@ -46,9 +46,11 @@ TEST(OverlayQuality, ShadowMapsOfTheAskedSizeAndObjectsStayWhereTheyWere) {
   replay.compositor().set_object_pose(0, moved);
 
   pipeline::OverlayQuality q = replay.overlay().quality();
-  q.shadow_map = 64, q.exact_lights = 3, q.shading = ObjectShading::PerVertex;
+  q.shadow_map = 64, q.exact_lights = 3, q.shading = ObjectShading::PerVertex, q.coverage_mesh_px = 2.0;
   replay.overlay().set_quality(q);
   EXPECT_TRUE(replay.overlay().quality() == q);
+  EXPECT_EQ(replay.compositor().renderer().coverage_mesh_error(), 2.0) << "the new compositor's renderer has it too";
+  EXPECT_EQ(q.describe(), "vertex, 8 lines, 3 lights, 64 px shadow maps, 2 px coverage meshes");
   EXPECT_EQ(replay.compositor().irradiance_volume()->shadow_n, 64);
   EXPECT_EQ(replay.compositor().irradiance_volume()->lights.size(), 3u);
   EXPECT_EQ(replay.compositor().object_shading(), ObjectShading::PerVertex);
@@ -58,6 +60,8 @@ TEST(OverlayQuality, ShadowMapsOfTheAskedSizeAndObjectsStayWhereTheyWere) {
   bad.shadow_map = 4;
   EXPECT_THROW(replay.overlay().set_quality(bad), InputError);
   bad = q, bad.exact_lights = kMaxExactLights + 1;
+  EXPECT_THROW(replay.overlay().set_quality(bad), InputError);
+  bad = q, bad.coverage_mesh_px = -1.0;
   EXPECT_THROW(replay.overlay().set_quality(bad), InputError);
   EXPECT_TRUE(replay.overlay().quality() == q) << "a refused quality changes nothing";
   // Back to the manifest's light count.

@@ -53,6 +53,9 @@ void check_quality(const OverlayQuality& q) {
   if (q.shadow_map && (*q.shadow_map < kMinShadowMapResolution || *q.shadow_map > kMaxShadowMapResolution))
     throw InputError(fmt::format("shadow maps of {} texels per side; use {} to {}", *q.shadow_map,
                                  kMinShadowMapResolution, kMaxShadowMapResolution));
+  if (!(q.coverage_mesh_px >= 0.0 && q.coverage_mesh_px <= gl::Renderer::kMaxCoverageErrorPx))
+    throw InputError(fmt::format("coverage meshes within {} px; use 0 (as given) to {}", q.coverage_mesh_px,
+                                 gl::Renderer::kMaxCoverageErrorPx));
   if (q.shadows.lines_per_patch < 1 || q.shadows.lines_per_patch > ShadowQuality::kMaxLinesPerPatch)
     throw InputError(fmt::format("{} shadow lines per patch; use 1 to {}", q.shadows.lines_per_patch,
                                  ShadowQuality::kMaxLinesPerPatch));
@@ -60,10 +63,11 @@ void check_quality(const OverlayQuality& q) {
 }  // namespace
 
 std::string OverlayQuality::describe() const {
-  return fmt::format("{}, {} lines, {} lights, {} shadow maps",
+  return fmt::format("{}, {} lines, {} lights, {} shadow maps, {} coverage meshes",
                      shading == ObjectShading::PerVertex ? "vertex" : "pixel", shadows.lines_per_patch,
                      exact_lights ? std::to_string(*exact_lights) : "the manifest's",
-                     shadow_map ? std::to_string(*shadow_map) + " px" : "the manifest's");
+                     shadow_map ? std::to_string(*shadow_map) + " px" : "the manifest's",
+                     coverage_mesh_px > 0 ? fmt::format("{:g} px", coverage_mesh_px) : "exact");
 }
 
 Overlay::Overlay(std::shared_ptr<const LoadedScene> scene, const CameraIntrinsics& camera,
@@ -104,6 +108,7 @@ Overlay::Overlay(std::shared_ptr<const LoadedScene> scene, const CameraIntrinsic
   compositor_->set_features(settings.features);
   compositor_->set_object_shading(quality_.shading);
   compositor_->set_shadow_quality(quality_.shadows);
+  compositor_->renderer().set_coverage_mesh_error(quality_.coverage_mesh_px);
   compositor_->renderer().set_video_radiometry(radiometry_);
   lighting_cells_ = settings.adapt_lighting_cells;
   set_adapt_lighting_every(settings.adapt_lighting_every);
@@ -164,6 +169,7 @@ void Overlay::set_scene(std::shared_ptr<const LoadedScene> scene) {
   const gl::CompositeFeatures features = compositor_->renderer().features();
   quality_.shading = compositor_->object_shading();
   quality_.shadows = compositor_->shadow_quality();
+  quality_.coverage_mesh_px = compositor_->renderer().coverage_mesh_error();
   scene_ = scene;
   compositor_.reset();  // its GL objects go first
   compositor_ = std::make_unique<Compositor>(with_volume_knobs(std::move(scene), quality_), maps_.output, maps_.map_x,
@@ -171,6 +177,7 @@ void Overlay::set_scene(std::shared_ptr<const LoadedScene> scene) {
   compositor_->set_features(features);
   compositor_->set_object_shading(quality_.shading);
   compositor_->set_shadow_quality(quality_.shadows);
+  compositor_->renderer().set_coverage_mesh_error(quality_.coverage_mesh_px);
   compositor_->renderer().set_video_radiometry(radiometry_);
   set_adapt_lighting_every(lighting_every_);
   frames_since_clip_check_ = kClipCheckEvery, clip_warned_ = false;  // other objects may clip
@@ -189,12 +196,14 @@ void Overlay::set_quality(const OverlayQuality& quality) {
   quality_ = quality;
   compositor_->set_object_shading(quality.shading);
   compositor_->set_shadow_quality(quality.shadows);
+  compositor_->renderer().set_coverage_mesh_error(quality.coverage_mesh_px);
 }
 
 OverlayQuality Overlay::quality() const {
   OverlayQuality q = quality_;
   q.shading = compositor_->object_shading();
   q.shadows = compositor_->shadow_quality();
+  q.coverage_mesh_px = compositor_->renderer().coverage_mesh_error();
   return q;
 }
 

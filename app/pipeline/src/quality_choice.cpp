@@ -119,6 +119,13 @@ QualityChoice choose_quality(Overlay& overlay, const std::vector<ProbeFrame>& fr
         return true;
       },
       std::vector<int>{64, 32});
+  step(
+      [](OverlayQuality& q, double px) {
+        if (px <= q.coverage_mesh_px) return false;
+        q.coverage_mesh_px = px;
+        return true;
+      },
+      std::vector<double>{2.0, 4.0});
 
   overlay.set_quality(choice.choice().quality);
   overlay.compositor().set_features(features);

@@ -3,10 +3,11 @@
 #include <string>
 
 #include "lumar/base/error.h"
+#include "mesh_levels.h"
 
 namespace lumar::gl {
 
-GpuMesh::GpuMesh(const Mesh& mesh, const char* what) {
+GpuMesh::GpuMesh(const Mesh& mesh, const char* what, bool with_levels) {
   if (mesh.indices.size() % 3 != 0)
     throw InputError(std::string(what) + ": index count is not a multiple of three; pass whole triangles");
   if (!mesh.normals.empty() && mesh.normals.size() != mesh.positions.size())
@@ -26,9 +27,15 @@ GpuMesh::GpuMesh(const Mesh& mesh, const char* what) {
     normals_ = create_buffer(mesh.normals.data(), mesh.normals.size() * sizeof(glm::vec3));
     attach_float_attribute(vao, 1, normals_.get(), 3);
   }
-  indices_ = create_buffer(mesh.indices.data(), mesh.indices.size() * sizeof(std::uint32_t));
+  // Every level's triangles one after another in one buffer.
+  std::vector<std::uint32_t> indices;
+  levels_.clear();
+  for (const MeshLevel& level : with_levels ? mesh_levels(mesh) : std::vector<MeshLevel>{{mesh.indices, 0.0f}}) {
+    levels_.push_back({GLsizei(indices.size()), GLsizei(level.indices.size()), level.error});
+    indices.insert(indices.end(), level.indices.begin(), level.indices.end());
+  }
+  indices_ = create_buffer(indices.data(), indices.size() * sizeof(std::uint32_t));
   glVertexArrayElementBuffer(vao, indices_.get());
-  index_count_ = GLsizei(mesh.indices.size());
   vertex_count_ = mesh.positions.size();
 }
 
@@ -64,10 +71,18 @@ void GpuMesh::set_vertex_irradiance(std::span<const glm::vec3> irradiance) {
   update_attribute(irradiance_, 5, 3, irradiance.data(), irradiance.size(), "vertex irradiance");
 }
 
-void GpuMesh::draw() const {
+void GpuMesh::draw(int level) const {
   if (empty()) return;
+  const Level& l = levels_[std::size_t(level)];
   glBindVertexArray(vertex_array_.get());
-  glDrawElements(GL_TRIANGLES, index_count_, GL_UNSIGNED_INT, nullptr);
+  glDrawElements(GL_TRIANGLES, l.count, GL_UNSIGNED_INT,
+                 reinterpret_cast<const void*>(std::uintptr_t(l.first) * sizeof(std::uint32_t)));
+}
+
+int GpuMesh::level_within(float max_error) const {
+  int level = 0;
+  while (level + 1 < int(levels_.size()) && levels_[std::size_t(level + 1)].error <= max_error) ++level;
+  return level;
 }
 
 }  // namespace lumar::gl

@@ -85,6 +85,8 @@ struct MultisampleTarget {
 
 GLint uniform(GLuint program, const char* name) { return glGetUniformLocation(program, name); }
 
+constexpr int kMaxBlurRadius = 12;  // pixels: the camera's blur is at most sigma 4
+
 // Wall-clock stage timer; waits for the GPU at each mark so the stages are separable.
 class StageClock {
  public:
@@ -125,7 +127,22 @@ struct Renderer::Impl {
     std::array<glm::vec3, 9> sh{};
     glm::vec3 lo{0.0f}, hi{0.0f};  // model-space bounds
     bool vertex_lit = false;       // shaded by its per-vertex irradiance (set_object_vertex_irradiance)
+    int level = 0;                 // of its simplified meshes, for this frame's coverage (choose_levels)
   };
+
+  // Each object's coarsest mesh level within coverage_error_px of its mesh, where the
+  // object is nearest the camera: an error e (model units) at distance d (model units; a
+  // uniform scale cancels) spans at most e * f / d pixels.
+  void choose_levels(const Pose& T_world_camera) {
+    const float f = float(std::max(camera.fx, camera.fy));
+    for (Object& o : objects) {
+      o.level = 0;
+      if (coverage_error_px <= 0.0f) continue;
+      const glm::vec3 eye = glm::vec3(glm::inverse(o.model) * glm::vec4(glm::vec3(T_world_camera.translation), 1.0f));
+      const float d = glm::length(eye - glm::clamp(eye, o.lo, o.hi));
+      if (d > 0.0f) o.level = o.mesh.level_within(coverage_error_px * d / f);
+    }
+  }
 
   // The pixels the objects may cover (their boxes projected, 2 px more), clipped to the
   // image; the whole image when a box reaches behind the camera.
@@ -165,6 +182,7 @@ struct Renderer::Impl {
   glm::vec3 noise_read_variance{0.0f}, noise_shot_gain{0.0f};  // RGB
   float blur_sigma = 0.0f;
   CompositeFeatures features;
+  float coverage_error_px = 0.0f;
   std::uint32_t frame_number = 0;  // seeds the noise: a new draw every frame
 
   std::unique_ptr<IrradianceTextures> volume;  // shades objects when set
@@ -174,8 +192,8 @@ struct Renderer::Impl {
 
   RenderTarget scene;                  // linear colour (RGBA32F) and depth, output size
   MultisampleTarget multisampled;      // the objects' coverage, 4 samples per pixel
-  RenderTarget coverage, antialiased;  // its resolve (R8), and the scene antialiased by it
-  RenderTarget blurred_rows, blurred;  // the blur's two passes (RGBA32F)
+  RenderTarget coverage;               // its resolve (R8)
+  RenderTarget scratch, scratch_rows;  // a copy of part of `scene`, the blur's rows (RGBA32F)
   RenderTarget encoded;                // sRGB 8-bit, output size, rows flipped for read-back
   RenderTarget room_target;            // for render_room_radiance, resized on demand
 
@@ -207,7 +225,9 @@ struct Renderer::Impl {
     glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
   }
 
-  void draw_objects(GLuint program, const glm::mat4& vp, bool shaded, float exposure) {
+  // outline_only: what is drawn is only where the objects are, not how they look (their
+  // coverage), so each may be its simplified mesh of this frame (choose_levels).
+  void draw_objects(GLuint program, const glm::mat4& vp, bool shaded, float exposure, bool outline_only = false) {
     glUseProgram(program);
     if (shaded) glProgramUniform1f(program, uniform(program, "exposure"), exposure);
     if (shaded) glProgramUniform1i(program, uniform(program, "use_volume"), volume ? 1 : 0);
@@ -220,7 +240,7 @@ struct Renderer::Impl {
         glProgramUniform3fv(program, uniform(program, "sh"), 9, glm::value_ptr(o.sh[0]));
         glProgramUniform1i(program, uniform(program, "use_vertex_irradiance"), o.vertex_lit ? 1 : 0);
       }
-      o.mesh.draw();
+      o.mesh.draw(outline_only ? o.level : 0);
     }
   }
 
@@ -243,71 +263,96 @@ struct Renderer::Impl {
     upload_bgr8(video.get(), frame);
   }
 
-  // Antialiasing of `scene` at the cost of one shaded sample per pixel: the objects' coverage of
-  // each pixel from a multisampled pass that only rasterises (the proxy's depth, then the
-  // objects with a constant colour), then each outline pixel mixes the object's and the
-  // video's colours by that coverage, the kind its centre missed taken from its 3x3
-  // neighbours. Shading every sample instead costs llvmpipe five times the objects' time.
-  // Only within the objects' footprint: multisampled passes are dear on a software rasteriser.
-  GLuint antialias(const glm::mat4& vp) {
-    if (coverage.width != camera.width || coverage.height != camera.height) {
+  // `scene`'s pixels within `rect` (GL rows, bottom up) copied to `scratch`, at the same
+  // place: a pass that reads its neighbours can then write into `scene` itself, and
+  // only the pixels it changes are touched, not the whole image.
+  void copy_scene(const cv::Rect& rect, const RenderTarget& to) const {
+    glBlitNamedFramebuffer(scene.framebuffer.get(), to.framebuffer.get(), rect.x, rect.y, rect.x + rect.width,
+                           rect.y + rect.height, rect.x, rect.y, rect.x + rect.width, rect.y + rect.height,
+                           GL_COLOR_BUFFER_BIT, GL_NEAREST);
+  }
+
+  // Binds `target` for a pass limited to `rect` (scissored; nothing cleared).
+  void begin_within(const RenderTarget& target, const cv::Rect& rect) const {
+    glBindFramebuffer(GL_FRAMEBUFFER, target.framebuffer.get());
+    glViewport(0, 0, target.width, target.height);
+    glEnable(GL_SCISSOR_TEST);
+    glScissor(rect.x, rect.y, rect.width, rect.height);
+  }
+
+  void make_scratch() {
+    if (scratch.width == camera.width && scratch.height == camera.height) return;
+    scratch = RenderTarget(camera.width, camera.height, GL_RGBA32F, false, "the scene's copy");
+    scratch_rows = RenderTarget(camera.width, camera.height, GL_RGBA32F, false, "the blur's rows");
+  }
+
+  // Antialiasing of `scene`, in place, at the cost of one shaded sample per pixel: the
+  // objects' coverage of each pixel from a multisampled pass that only rasterises (the
+  // proxy's depth, then the objects with a constant colour), then each outline pixel
+  // mixes the object's and the video's colours by that coverage, the kind its centre
+  // missed taken from its 3x3 neighbours. Shading every sample instead costs llvmpipe five
+  // times the objects' time. Only within the objects' footprint `box`: multisampled passes
+  // and whole-image copies are dear on a software rasteriser.
+  void antialias(const glm::mat4& vp, const cv::Rect& box, const Pose& T_world_camera) {
+    if (box.empty()) return;
+    make_scratch();
+    if (coverage.width != camera.width || coverage.height != camera.height)
       coverage = RenderTarget(camera.width, camera.height, GL_R8, false, "the objects' coverage");
-      antialiased = RenderTarget(camera.width, camera.height, GL_RGBA32F, false, "the antialiased scene");
-    }
-    const cv::Rect box = objects_footprint(vp);
-    coverage.begin();  // zero outside the footprint
-    if (!box.empty()) {
-      glEnable(GL_SCISSOR_TEST);
-      glScissor(box.x, box.y, box.width, box.height);
-      multisampled.begin();  // clears within the scissor only
-      glEnable(GL_DEPTH_TEST);
-      glDepthFunc(GL_LESS);
-      glDepthMask(GL_TRUE);
-      draw_room_depth(vp);
-      draw_objects(covered.get(), vp, false, 0.0f);
-      glDisable(GL_DEPTH_TEST);
-      glDisable(GL_SCISSOR_TEST);
-      glBlitNamedFramebuffer(multisampled.framebuffer.get(), coverage.framebuffer.get(), box.x, box.y,
-                             box.x + box.width, box.y + box.height, box.x, box.y, box.x + box.width, box.y + box.height,
-                             GL_COLOR_BUFFER_BIT, GL_NEAREST);
-    }
-    // The scene as it is, then the outline pixels within the footprint mixed anew.
-    glBlitNamedFramebuffer(scene.framebuffer.get(), antialiased.framebuffer.get(), 0, 0, camera.width, camera.height, 0,
-                           0, camera.width, camera.height, GL_COLOR_BUFFER_BIT, GL_NEAREST);
-    if (box.empty()) return antialiased.color.get();
-    glBindFramebuffer(GL_FRAMEBUFFER, antialiased.framebuffer.get());
-    glViewport(0, 0, camera.width, camera.height);
     glEnable(GL_SCISSOR_TEST);
     glScissor(box.x, box.y, box.width, box.height);
+    multisampled.begin();  // clears within the scissor only
+    glEnable(GL_DEPTH_TEST);
+    glDepthFunc(GL_LESS);
+    glDepthMask(GL_TRUE);
+    draw_room_depth(vp);
+    choose_levels(T_world_camera);
+    draw_objects(covered.get(), vp, false, 0.0f, true);
+    glDisable(GL_DEPTH_TEST);
+    glDisable(GL_SCISSOR_TEST);
+    glBlitNamedFramebuffer(multisampled.framebuffer.get(), coverage.framebuffer.get(), box.x, box.y, box.x + box.width,
+                           box.y + box.height, box.x, box.y, box.x + box.width, box.y + box.height, GL_COLOR_BUFFER_BIT,
+                           GL_NEAREST);
+    // The resolve reads each pixel's 3x3 neighbours.
+    copy_scene(grown(box, 1), scratch);
+    begin_within(scene, box);
     glUseProgram(antialias_resolve.get());
-    glBindTextureUnit(shaders::kLinearImageUnit, scene.color.get());
+    glBindTextureUnit(shaders::kLinearImageUnit, scratch.color.get());
     glBindTextureUnit(shaders::kCoverageUnit, coverage.color.get());
     draw_fullscreen();
     glDisable(GL_SCISSOR_TEST);
-    return antialiased.color.get();
   }
 
-  // The camera's blur on what was rendered: a separable Gaussian of `linear` (rows, then
-  // columns), kept only where it reaches a rendered pixel (alpha > 0); the video
-  // elsewhere has the camera's blur already. Returns the blurred image's texture.
-  GLuint blur_rendered(GLuint linear) {
-    if (blurred.width != camera.width || blurred.height != camera.height) {
-      blurred_rows = RenderTarget(camera.width, camera.height, GL_RGBA32F, false, "the blur's rows");
-      blurred = RenderTarget(camera.width, camera.height, GL_RGBA32F, false, "the blur");
-    }
+  // `rect` grown by `margin` pixels each way, clipped to the image.
+  cv::Rect grown(const cv::Rect& rect, int margin) const {
+    return cv::Rect(rect.x - margin, rect.y - margin, rect.width + 2 * margin, rect.height + 2 * margin) &
+           cv::Rect(0, 0, camera.width, camera.height);
+  }
+
+  // The camera's blur on what was rendered, in `scene` in place: a separable Gaussian
+  // (rows, then columns), kept only where it reaches a rendered pixel (alpha > 0); the
+  // video elsewhere has the camera's blur already. Rendered pixels lie within the objects'
+  // footprint `box`, so only that box grown by the kernel's radius can change.
+  void blur_rendered(const cv::Rect& box) {
+    if (box.empty()) return;
+    make_scratch();
+    const int radius = std::min(int(std::ceil(3.0f * blur_sigma)), kMaxBlurRadius);
+    const cv::Rect changed = grown(box, radius), read = grown(box, 2 * radius);
+    copy_scene(read, scratch);
     const GLuint p = blur.get();
     glUseProgram(p);
     glProgramUniform1f(p, uniform(p, "sigma"), blur_sigma);
-    glBindTextureUnit(shaders::kLinearImageUnit, linear);
-    glBindTextureUnit(shaders::kBlurSourceUnit, linear);
-    blurred_rows.begin();
+    glProgramUniform1i(p, uniform(p, "radius"), radius);
+    glBindTextureUnit(shaders::kLinearImageUnit, scratch.color.get());
+    glBindTextureUnit(shaders::kBlurSourceUnit, scratch.color.get());
+    // The rows wherever the columns will read them: the changed columns, the rows a radius beyond.
+    begin_within(scratch_rows, cv::Rect(changed.x, read.y, changed.width, read.height));
     glProgramUniform2i(p, uniform(p, "step"), 1, 0);
     draw_fullscreen();
-    blurred.begin();
-    glBindTextureUnit(shaders::kBlurSourceUnit, blurred_rows.color.get());
+    begin_within(scene, changed);
+    glBindTextureUnit(shaders::kBlurSourceUnit, scratch_rows.color.get());
     glProgramUniform2i(p, uniform(p, "step"), 0, 1);
     draw_fullscreen();
-    return blurred.color.get();
+    glDisable(GL_SCISSOR_TEST);
   }
 
   // Visible object positions after proxy occlusion, into `scene`; RGBA32F, row 0 at the bottom.
@@ -392,7 +437,7 @@ void Renderer::set_environment(const EnvironmentMap& map) {
 
 int Renderer::add_object(const Mesh& mesh_model) {
   Impl::Object o;
-  o.mesh = GpuMesh(mesh_model, "virtual object mesh");
+  o.mesh = GpuMesh(mesh_model, "virtual object mesh", true);
   std::tie(o.lo, o.hi) = mesh_model.bounds();
   if (mesh_model.normals.empty() && !mesh_model.indices.empty())
     throw InputError("Renderer::add_object: the virtual object mesh has no normals; load it with load_mesh");
@@ -435,6 +480,21 @@ void Renderer::set_object_self_occlusion(int id, std::span<const VertexOcclusion
 void Renderer::set_features(const CompositeFeatures& features) { impl_->features = features; }
 
 const CompositeFeatures& Renderer::features() const { return impl_->features; }
+
+void Renderer::set_coverage_mesh_error(double pixels) {
+  if (!(pixels >= 0.0 && pixels <= kMaxCoverageErrorPx))
+    throw InputError("Renderer::set_coverage_mesh_error: " + std::to_string(pixels) +
+                     " pixels; use 0 (the meshes as given) to " + std::to_string(int(kMaxCoverageErrorPx)));
+  impl_->coverage_error_px = float(pixels);
+}
+
+double Renderer::coverage_mesh_error() const { return impl_->coverage_error_px; }
+
+std::size_t Renderer::coverage_triangles() const {
+  std::size_t n = 0;
+  for (const Impl::Object& o : impl_->objects) n += o.mesh.empty() ? 0 : o.mesh.triangles(o.level);
+  return n;
+}
 
 void Renderer::set_object_material(int id, const glm::vec3& albedo, const SH9& irradiance_sh) {
   Impl::Object& o = impl_->object(id, "set_object_material");
@@ -581,14 +641,20 @@ cv::Mat Renderer::render_overlay(const cv::Mat& video_bgr8, const std::optional<
     glDisable(GL_DEPTH_TEST);
     clock.mark(&t.objects_ms);
   }
-  GLuint linear_image = r.scene.color.get();
-  if (T_world_camera && r.features.antialiasing && r.multisampled.samples > 1) {
-    linear_image = r.antialias(Impl::view_projection(r.camera, *T_world_camera));
-    clock.mark(&t.antialiasing_ms);
-  }
-  if (T_world_camera && r.features.blur && r.blur_sigma > 0.0f) {
-    linear_image = r.blur_rendered(linear_image);
-    clock.mark(&t.blur_ms);
+  // Antialiasing and blur change `scene` in place, only within the objects' footprint.
+  const bool antialiasing = r.features.antialiasing && r.multisampled.samples > 1;
+  const bool blur = r.features.blur && r.blur_sigma > 0.0f;
+  if (T_world_camera && (antialiasing || blur)) {
+    const glm::mat4 vp = Impl::view_projection(r.camera, *T_world_camera);
+    const cv::Rect footprint = r.objects_footprint(vp);
+    if (antialiasing) {
+      r.antialias(vp, footprint, *T_world_camera);
+      clock.mark(&t.antialiasing_ms);
+    }
+    if (blur) {
+      r.blur_rendered(footprint);
+      clock.mark(&t.blur_ms);
+    }
   }
 
   // Encode to sRGB 8-bit (rows flipped) and read back top row first.
@@ -605,7 +671,7 @@ cv::Mat Renderer::render_overlay(const cv::Mat& video_bgr8, const std::optional<
   glProgramUniform1f(enc, uniform(enc, "half_diagonal"), 0.5f * std::hypot(float(vc.width), float(vc.height)));
   glBindTextureUnit(shaders::kUndistortionMapUnit, r.undistortion_map.get());
   glProgramUniform2fv(enc, uniform(enc, "vignetting"), 1, glm::value_ptr(r.vignetting));
-  glBindTextureUnit(shaders::kLinearImageUnit, linear_image);
+  glBindTextureUnit(shaders::kLinearImageUnit, r.scene.color.get());
   glBindTextureUnit(shaders::kResponseEncodeUnit, r.response_encode.get());
   const bool noise =
       r.features.noise && (r.noise_read_variance != glm::vec3(0.0f) || r.noise_shot_gain != glm::vec3(0.0f));

@@ -225,11 +225,11 @@ const char* const kBlurFragment = R"glsl(
 layout(binding = 3) uniform sampler2D linear_image;  // the unblurred image (alpha 1: rendered)
 layout(binding = 6) uniform sampler2D source;        // this pass's input
 uniform float sigma;  // pixels
+uniform int radius;   // pixels: min(ceil(3 sigma), 12)
 uniform ivec2 step;   // (1, 0): rows; (0, 1): columns, the last pass
 out vec4 color;
 void main() {
   ivec2 p = ivec2(gl_FragCoord.xy), size = textureSize(source, 0);
-  int radius = min(int(ceil(3.0 * sigma)), 12);
   vec4 sum = vec4(0.0);
   float total = 0.0;
   for (int i = -radius; i <= radius; ++i) {

@@ -33,8 +33,13 @@ struct OverlayQuality {
   // shadow maps, instead of its shadow_map_resolution (8 to 1024); the volume is built, or
   // taken from the cache, for them.
   std::optional<int> exact_lights, shadow_map;
+  // The antialiasing's coverage from simplified meshes within this many output pixels of
+  // the objects' own (gl::Renderer::set_coverage_mesh_error); 0: the meshes as given. At 1
+  // px the composite's error against the truth does not change (docs/results.md).
+  double coverage_mesh_px = 1.0;
   bool operator==(const OverlayQuality&) const = default;
-  // "vertex, 4 lines, 6 lights, 64 px shadow maps" (unset counts as "manifest's").
+  // "vertex, 4 lines, 6 lights, 64 px shadow maps, 1 px coverage meshes" (unset counts as
+  // "manifest's").
   std::string describe() const;
 };
 

@@ -11,9 +11,10 @@
 //
 // The search is greedy, from full quality, one knob at a time in the order of what each
 // may save: shading per vertex; half, then a quarter of the shadow lines; 6, then 2 exact
-// lights; shadow maps of 64, then 32 texels. A step is kept when its three differences are
-// within the budget and its frames are faster than the best so far by kQualityMinGain; a
-// knob's next level is not tried once one is outside the budget.
+// lights; shadow maps of 64, then 32 texels; coverage meshes within 2, then 4 px. A step is
+// kept when its three differences are within the budget and its frames are faster than the
+// best so far by kQualityMinGain; a knob's next level is not tried once one is outside the
+// budget.
 #include <vector>
 
 #include "lumar/pipeline/composite_error.h"

@@ -120,6 +120,16 @@ class Renderer {
   // Default: all on. Antialiasing needs the driver's multisampling (4 samples, else what it has).
   void set_features(const CompositeFeatures& features);
   const CompositeFeatures& features() const;
+  // The antialiasing's coverage needs only the objects' outlines: each frame it draws each
+  // object with the coarsest of its simplified meshes (about half the triangles each)
+  // whose surface is within this many output pixels of the mesh's, where the object is
+  // nearest the camera. The shading always draws the mesh as given. 0 (the default): the
+  // meshes as given. Throws InputError outside [0, kMaxCoverageErrorPx].
+  void set_coverage_mesh_error(double pixels);
+  double coverage_mesh_error() const;
+  // The objects' triangles the last antialiasing pass drew.
+  std::size_t coverage_triangles() const;
+  static constexpr double kMaxCoverageErrorPx = 8.0;
 
   // One composited frame (BGR8, output size). `video_bgr8` is the distorted video frame
   // (CV_8UC3, the undistortion map's source size); `exposure` is the video's linear
