@@ -7,7 +7,6 @@
 #include <cmath>
 #include <numbers>
 
-#include "lumar/base/color.h"
 #include "lumar/base/constants.h"
 #include "lumar/base/error.h"
 #include "lumar/render/renderer.h"
@@ -16,22 +15,6 @@
 namespace lumar::test {
 namespace {
 
-// Uniform incoming radiance r: E = pi r, so the object's linear value is albedo r exposure.
-SH9 uniform_light(double r) {
-  SH9 sh;
-  sh.coefficients[0] = glm::dvec3(r * 0.282095 * 4.0 * kPi);
-  return sh;
-}
-
-cv::Mat linear_of(const cv::Mat& bgr8) {
-  cv::Mat out(bgr8.size(), CV_32FC3);
-  for (int r = 0; r < bgr8.rows; ++r)
-    for (int c = 0; c < bgr8.cols; ++c)
-      for (int k = 0; k < 3; ++k)
-        out.at<cv::Vec3f>(r, c)[k] = srgb_to_linear(float(bgr8.at<cv::Vec3b>(r, c)[k]) / 255.0f);
-  return out;
-}
-
 constexpr gl::CompositeFeatures kNone{false, false, false, false};
 
 // A camera looking down -z at a quad of `half` half-width at z = -2, lit to linear `value`.
@@ -39,7 +22,7 @@ struct FlatObject {
   explicit FlatObject(float value, float half = 0.5f, glm::vec3 centre = {0, 0, -2}) {
     renderer = std::make_unique<gl::Renderer>(camera);
     id = renderer->add_object(make_quad(centre, {half, 0, 0}, {0, half, 0}, {0, 0, 1}));
-    renderer->set_object_material(id, glm::vec3(1.0f), uniform_light(value));
+    renderer->set_object_material(id, glm::vec3(1.0f), uniform_sh(value));
   }
   CameraIntrinsics camera = make_camera(160, 120, 150, 150, 79.5, 59.5);
   Pose pose = look_at({0, 0, 0}, {0, 0, -1});
@@ -87,7 +70,7 @@ TEST(CompositeFeatures, AntialiasingGivesTheOutlineItsCoverage) {
   gl::Renderer renderer(camera);
   const float radius = 0.3f;
   const int sphere = renderer.add_object(make_sphere({0, 0, -2}, radius, 256, 128));
-  renderer.set_object_material(sphere, glm::vec3(1.0f), uniform_light(0.5));
+  renderer.set_object_material(sphere, glm::vec3(1.0f), uniform_sh(0.5));
   const cv::Mat black(240, 320, CV_8UC3, cv::Scalar::all(0));
   // A sphere straight ahead is a disc of radius f r / sqrt(d^2 - r^2).
   const double disc_radius = 300.0 * radius / std::sqrt(4.0 - radius * radius);

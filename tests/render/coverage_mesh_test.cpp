@@ -9,8 +9,6 @@
 #include <cmath>
 #include <numbers>
 
-#include "lumar/base/color.h"
-#include "lumar/base/constants.h"
 #include "lumar/base/error.h"
 #include "lumar/render/renderer.h"
 #include "render_test_util.h"
@@ -25,19 +23,15 @@ struct Sphere {
   explicit Sphere(double coverage_error_px) : renderer(kCamera) {
     mesh = make_sphere({0, 0, 0}, kRadius, 128, 64);
     const int id = renderer.add_object(mesh);
-    SH9 white;  // uniform radiance 1: E = pi, so the linear value is 1
-    white.coefficients[0] = glm::dvec3(0.282095 * 4.0 * kPi);
-    renderer.set_object_material(id, glm::vec3(1.0f), white);
+    renderer.set_object_material(id, glm::vec3(1.0f), uniform_sh(1.0));  // linear value 1
     renderer.set_features({.antialiasing = true, .self_occlusion = false, .noise = false, .blur = false});
     renderer.set_coverage_mesh_error(coverage_error_px);
   }
-  // Each pixel's coverage as drawn: its linear value.
+  // Each pixel's coverage as drawn: its linear value (green).
   cv::Mat coverage(const Pose& pose) {
-    const cv::Mat out =
-        renderer.render_overlay(cv::Mat(kCamera.height, kCamera.width, CV_8UC3, cv::Scalar::all(0)), pose, 1.0);
-    cv::Mat c(out.size(), CV_32F);
-    for (int y = 0; y < out.rows; ++y)
-      for (int x = 0; x < out.cols; ++x) c.at<float>(y, x) = srgb_to_linear(out.at<cv::Vec3b>(y, x)[1] / 255.0f);
+    const cv::Mat black(kCamera.height, kCamera.width, CV_8UC3, cv::Scalar::all(0));
+    cv::Mat c;
+    cv::extractChannel(linear_of(renderer.render_overlay(black, pose, 1.0)), c, 1);
     return c;
   }
   Mesh mesh;

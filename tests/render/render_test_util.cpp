@@ -5,6 +5,8 @@
 #include <numbers>
 #include <opencv2/calib3d.hpp>
 
+#include "lumar/base/color.h"
+
 namespace lumar::test {
 
 gl::Context& headless_context() {
@@ -68,6 +70,21 @@ CameraIntrinsics make_camera(int w, int h, double fx, double fy, double cx, doub
   c.cx = cx;
   c.cy = cy;
   return c;
+}
+
+SH9 uniform_sh(double radiance) {
+  SH9 sh;
+  sh.coefficients[0] = glm::dvec3(radiance * 0.282095 * 4.0 * std::numbers::pi);  // ∫ L Y00 dω
+  return sh;
+}
+
+cv::Mat linear_of(const cv::Mat& bgr8) {
+  cv::Mat out(bgr8.size(), CV_32FC3);
+  for (int r = 0; r < bgr8.rows; ++r)
+    for (int c = 0; c < bgr8.cols; ++c)
+      for (int k = 0; k < 3; ++k)
+        out.at<cv::Vec3f>(r, c)[k] = srgb_to_linear(float(bgr8.at<cv::Vec3b>(r, c)[k]) / 255.0f);
+  return out;
 }
 
 }  // namespace lumar::test

@@ -29,4 +29,10 @@ glm::dvec3 sh_irradiance_reference(const SH9& sh, const glm::dvec3& n);
 
 CameraIntrinsics make_camera(int w, int h, double fx, double fy, double cx, double cy);
 
+// Nine coefficients of a uniform incoming radiance: E = pi * radiance everywhere, so a
+// surface of albedo a at exposure 1 has the linear value a * radiance.
+SH9 uniform_sh(double radiance);
+// A BGR8 sRGB image's linear values (CV_32FC3, BGR).
+cv::Mat linear_of(const cv::Mat& bgr8);
+
 }  // namespace lumar::test

@@ -14,12 +14,6 @@
 namespace lumar::test {
 namespace {
 
-SH9 uniform_sh(double radiance) {
-  SH9 sh;
-  sh.coefficients[0] = glm::dvec3(radiance * 0.282095 * 4.0 * kPi);  // ∫ L Y00 dω
-  return sh;
-}
-
 // Brute-force projection of a radiance function onto the basis, texel by texel.
 template <class Radiance>
 SH9 integrate_sh(Radiance radiance, int width, int height) {

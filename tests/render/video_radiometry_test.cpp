@@ -45,9 +45,7 @@ TEST(VideoRadiometry, RenderedPixelsGetTheResponseAndTheVignetting) {
   // A quad filling the view, lit by a uniform radiance of 1: linear = albedo * exposure.
   const int id = renderer.add_object(make_quad({0, 0, -1}, {1.5f, 0, 0}, {0, 1.5f, 0}, {0, 0, 1}));
   const glm::vec3 albedo(0.5f, 0.3f, 0.2f);  // R, G, B
-  SH9 sh;
-  sh.coefficients[0] = glm::dvec3(0.282095 * 4.0 * 3.14159265358979);
-  renderer.set_object_material(id, albedo, sh);
+  renderer.set_object_material(id, albedo, uniform_sh(1.0));
   const double exposure = 0.9;
   const cv::Mat out =
       renderer.render_overlay(cv::Mat(120, 160, CV_8UC3, cv::Scalar::all(0)), look_at({0, 0, 0}, {0, 0, -1}), exposure);

@@ -263,13 +263,13 @@ struct Renderer::Impl {
     upload_bgr8(video.get(), frame);
   }
 
-  // `scene`'s pixels within `rect` (GL rows, bottom up) copied to `scratch`, at the same
-  // place: a pass that reads its neighbours can then write into `scene` itself, and
-  // only the pixels it changes are touched, not the whole image.
-  void copy_scene(const cv::Rect& rect, const RenderTarget& to) const {
-    glBlitNamedFramebuffer(scene.framebuffer.get(), to.framebuffer.get(), rect.x, rect.y, rect.x + rect.width,
-                           rect.y + rect.height, rect.x, rect.y, rect.x + rect.width, rect.y + rect.height,
-                           GL_COLOR_BUFFER_BIT, GL_NEAREST);
+  // The pixels within `rect` (GL rows, bottom up) of one framebuffer copied to the same
+  // place in another (a multisampled source is resolved). Copying part of `scene` lets a
+  // pass that reads its neighbours write into `scene` itself, touching only the pixels it
+  // changes, not the whole image.
+  static void copy_within(GLuint from, const RenderTarget& to, const cv::Rect& rect) {
+    glBlitNamedFramebuffer(from, to.framebuffer.get(), rect.x, rect.y, rect.x + rect.width, rect.y + rect.height,
+                           rect.x, rect.y, rect.x + rect.width, rect.y + rect.height, GL_COLOR_BUFFER_BIT, GL_NEAREST);
   }
 
   // Binds `target` for a pass limited to `rect` (scissored; nothing cleared).
@@ -309,11 +309,9 @@ struct Renderer::Impl {
     draw_objects(covered.get(), vp, false, 0.0f, true);
     glDisable(GL_DEPTH_TEST);
     glDisable(GL_SCISSOR_TEST);
-    glBlitNamedFramebuffer(multisampled.framebuffer.get(), coverage.framebuffer.get(), box.x, box.y, box.x + box.width,
-                           box.y + box.height, box.x, box.y, box.x + box.width, box.y + box.height, GL_COLOR_BUFFER_BIT,
-                           GL_NEAREST);
+    copy_within(multisampled.framebuffer.get(), coverage, box);
     // The resolve reads each pixel's 3x3 neighbours.
-    copy_scene(grown(box, 1), scratch);
+    copy_within(scene.framebuffer.get(), scratch, grown(box, 1));
     begin_within(scene, box);
     glUseProgram(antialias_resolve.get());
     glBindTextureUnit(shaders::kLinearImageUnit, scratch.color.get());
@@ -337,7 +335,7 @@ struct Renderer::Impl {
     make_scratch();
     const int radius = std::min(int(std::ceil(3.0f * blur_sigma)), kMaxBlurRadius);
     const cv::Rect changed = grown(box, radius), read = grown(box, 2 * radius);
-    copy_scene(read, scratch);
+    copy_within(scene.framebuffer.get(), scratch, read);
     const GLuint p = blur.get();
     glUseProgram(p);
     glProgramUniform1f(p, uniform(p, "sigma"), blur_sigma);
