@@ -130,6 +130,36 @@ TEST(ObjectBounce, SphereOnAPlaneSendsItsAlbedoTimesWhatItBlocks) {
   }
 }
 
+// A receiver the room hardly lights (a point under a table block, reached only through
+// the lines' ties) takes its ratio against a tenth of the receivers' median E_without, not
+// its own: the same bounce, bounded, and the same whether its E_without came out 0 or
+// a leak's few lines.
+TEST(ObjectBounce, DarkReceiversTakeTheRatioAgainstATenthOfTheMedian) {
+  const double R = 1.0, albedo = 0.5, d = 1.0;
+  std::vector<glm::vec3> positions, normals, without;
+  for (double x : kDistances)
+    positions.push_back({float(x), 0.0f, 0.0f}), normals.push_back({0, 1, 0}), without.push_back(glm::vec3(float(kPi)));
+  // Three receivers at the same point: lit, dark (a leak), and black.
+  for (float e : {float(kPi), 1e-3f * float(kPi), 0.0f})
+    positions.push_back({0.0f, 0.0f, float(d)}), normals.push_back({0, 1, 0}), without.push_back(glm::vec3(e));
+  const auto uniform = [](const glm::vec3&, const glm::vec3&) { return glm::vec3(float(kPi)); };
+  ObjectBounce bounce(positions, normals, without);
+  bounce.add_object(test::make_sphere({0, 0, 0}, float(R), 96, 48), glm::vec3(float(albedo)), translation(0, R, 0));
+  ASSERT_TRUE(bounce.update(uniform));
+  const std::size_t lit = kDistances.size(), leak = lit + 1, black = lit + 2;
+  const glm::vec3 r_lit = bounce.ratio()[lit];
+  EXPECT_NEAR(r_lit.g, albedo * sphere_form_factor(R, d), 0.03 * albedo * sphere_form_factor(R, d));
+  // The median E_without is π, so the floor is π/10: ten times the lit ratio, not 1000.
+  const float scale = 1.0f / ObjectBounce::kDarkReceiverShare;
+  EXPECT_NEAR(bounce.ratio()[leak].g, scale * r_lit.g, 1e-4f * scale * r_lit.g);
+  EXPECT_EQ(bounce.ratio()[black], bounce.ratio()[leak]);
+  // Relit brighter, the floor follows the median.
+  for (glm::vec3& e : without) e *= 2.0f;
+  bounce.relight(without);
+  ASSERT_TRUE(bounce.update(uniform));
+  EXPECT_NEAR(bounce.ratio()[black].g, scale * r_lit.g / 2.0f, 1e-4f * scale * r_lit.g);
+}
+
 TEST(ObjectBounce, SpheresUnderAUniformSkyLightEachOther) {
   // Each sphere is lit by E = π, so its radiance is its albedo ρ, and a point that sees
   // the whole of a sphere of radius R at distance D, at an angle θ from its normal, gets

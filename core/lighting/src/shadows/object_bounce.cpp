@@ -177,6 +177,20 @@ ObjectBounce::ObjectBounce(std::vector<glm::vec3> positions, std::vector<glm::ve
   if (settings_.clusters < 1) throw InputError("bounce: at least one surface cluster per object");
   bounce_.assign(positions_.size(), glm::vec3(0.0f));
   ratio_.assign(positions_.size(), glm::vec3(0.0f));
+  dark_floor_ = dark_floor(unshadowed_);
+}
+
+glm::vec3 ObjectBounce::dark_floor(const std::vector<glm::vec3>& unshadowed) {
+  glm::vec3 out(0.0f);
+  if (unshadowed.empty()) return out;
+  std::vector<float> channel(unshadowed.size());
+  for (int c = 0; c < 3; ++c) {
+    for (std::size_t i = 0; i < unshadowed.size(); ++i) channel[i] = unshadowed[i][c];
+    const auto middle = channel.begin() + std::ptrdiff_t(channel.size() / 2);
+    std::nth_element(channel.begin(), middle, channel.end());
+    out[c] = kDarkReceiverShare * *middle;
+  }
+  return out;
 }
 
 int ObjectBounce::add_object(const Mesh& model, const glm::vec3& albedo, const glm::dmat4& T_world_model) {
@@ -275,6 +289,7 @@ void ObjectBounce::relight(std::vector<glm::vec3> unshadowed) {
     throw RuntimeError("ObjectBounce::relight: " + std::to_string(unshadowed.size()) + " values for " +
                        std::to_string(positions_.size()) + " receivers");
   unshadowed_ = std::move(unshadowed);
+  dark_floor_ = dark_floor(unshadowed_);
   dirty_ = true;
 }
 
@@ -302,7 +317,10 @@ bool ObjectBounce::update(const Irradiance& irradiance) {
   }
   stats_.onto_objects_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t1).count();
   for (std::size_t i = 0; i < positions_.size(); ++i) {
-    for (int c = 0; c < 3; ++c) ratio_[i][c] = unshadowed_[i][c] > 0 ? bounce_[i][c] / unshadowed_[i][c] : 0.0f;
+    for (int c = 0; c < 3; ++c) {
+      const float without = std::max(unshadowed_[i][c], dark_floor_[c]);
+      ratio_[i][c] = without > 0 ? bounce_[i][c] / without : 0.0f;
+    }
     stats_.receivers_reached += bounce_[i] != glm::vec3(0.0f);
   }
   dirty_ = false;

@@ -104,8 +104,13 @@ class ObjectBounce {
   // unshadowed irradiance (one per receiver): the next update recomputes.
   void relight(std::vector<glm::vec3> unshadowed);
 
-  // Per receiver, E_bounce / E_without per channel (0 where nothing reaches it).
+  // Per receiver, E_bounce / E_without per channel (0 where nothing reaches it). E_without
+  // is taken as at least kDarkReceiverShare of the receivers' median: below that it is
+  // mostly the lines' own error (a point under a table block is reached only through
+  // ties that Embree's kernels break differently on different CPUs), which the ratio would
+  // amplify into a bright blot that the floor's interpolation spreads beyond the table.
   const std::vector<glm::vec3>& ratio() const { return ratio_; }
+  static constexpr float kDarkReceiverShare = 0.1f;
   // Per vertex of object id's mesh (model order): the irradiance the OTHER objects
   // reflect onto it (virtual onto virtual: a red box tints the figurine beside it), by
   // the same transfer as onto the receivers; all 0 with one object. RuntimeError for a
@@ -142,7 +147,11 @@ class ObjectBounce {
   void add_object_bounce(const Object& o, std::span<const glm::vec3> positions, std::span<const glm::vec3> normals,
                          std::span<glm::vec3> out);
 
+  // E_without's floor per channel in ratio(): kDarkReceiverShare of the median.
+  static glm::vec3 dark_floor(const std::vector<glm::vec3>& unshadowed);
+
   std::vector<glm::vec3> positions_, normals_, unshadowed_;
+  glm::vec3 dark_floor_{0.0f};
   BounceSettings settings_;
   std::vector<Object> objects_;
   std::vector<glm::vec3> bounce_, ratio_;
