@@ -78,4 +78,14 @@ std::vector<glm::dvec3> random_normals(int count, unsigned seed) {
   return out;
 }
 
+EnvironmentMap dim_sky_with_sun() {
+  EnvironmentMap map;
+  map.width = 256, map.height = 128;
+  map.rgb.assign(std::size_t(map.width) * map.height * 3, 0.2f);
+  for (int r = 30; r < 33; ++r)
+    for (int c = 40; c < 43; ++c)
+      for (int k = 0; k < 3; ++k) map.rgb[(std::size_t(r) * map.width + c) * 3 + std::size_t(k)] = 4000.0f;
+  return map;
+}
+
 }  // namespace lumar::test

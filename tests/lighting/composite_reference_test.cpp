@@ -98,6 +98,38 @@ TEST(CompositeReference, SphereReflectsItsAlbedoOfWhatItBlocks) {
   EXPECT_NEAR(luminance(ref.object_radiance(*hit, false)), 0.5, 0.01);
 }
 
+TEST(CompositeReference, AnotherObjectSendsItsOneBounceRadianceOntoAnObject) {
+  // Two unit spheres of albedo ½ under a uniform sky, centres 3 apart along z. From the
+  // point of A facing B, B covers sin²α = (R/d)² = ¼ of the cosine-weighted hemisphere
+  // (d = 2): black, it leaves E = ¾π. Reflecting, it sends back ρ E_B / π per ray, where
+  // E_B on its side facing A lies between ¾π (its pole, which A hides as much) and π:
+  // E between (¾ + ¼ · ½ · ¾)π and (¾ + ¼ · ½)π. The object's radiance is ½ E / π.
+  const EnvironmentMap map = uniform_sky(1.0f);
+  const RoomRadiance room{map, RadianceSettings{}};
+  const std::vector<LoadedObject> spheres{sphere_object(1.0, {0, 0, 0}, 0.5f), sphere_object(1.0, {0, 0, 3}, 0.5f)};
+  CompositeReferenceSettings settings;
+  settings.object_strata = 48;
+  for (bool bounce : {false, true}) {
+    settings.bounce = bounce;
+    const CompositeReference ref(room, spheres, settings);
+    const auto hit = ref.hit_object({0, 0, 1.5}, {0, 0, -1});
+    ASSERT_TRUE(hit.has_value());
+    ASSERT_EQ(hit->object, 0);
+    const double E = luminance(ref.object_radiance(*hit)) * kPi / 0.5;
+    std::printf("bounce %s: E / pi = %.4f\n", bounce ? "on" : "off", E / kPi);
+    if (bounce) {
+      EXPECT_GT(E / kPi, 0.75 + 0.25 * 0.5 * 0.75 - 0.01);
+      EXPECT_LT(E / kPi, 0.75 + 0.25 * 0.5 + 0.01);
+    } else {
+      EXPECT_NEAR(E / kPi, 0.75, 0.01);
+    }
+    // Its far side sees neither sphere: π either way (A does not light itself).
+    const auto back = ref.hit_object({0, 0, -5}, {0, 0, 1});
+    ASSERT_TRUE(back.has_value());
+    EXPECT_NEAR(luminance(ref.object_radiance(*back)) * kPi / 0.5, kPi, 0.01 * kPi);
+  }
+}
+
 TEST(CompositeReference, RatioTendsToOneAndIsOneBeyondReach) {
   SphereOnPlane s;
   CompositeReferenceSettings settings;

@@ -1,7 +1,8 @@
 // What makes rendered pixels look like the camera's (gl::CompositeFeatures), each against
 // an analytic expectation and switched off: the sensor's noise statistics, the coverage
 // that antialiasing gives a disc's outline, the Gaussian profile of a blurred edge, and the
-// self-occlusion's open share and bent normal.
+// self-occlusion's open share and bent normal, and the exact lights the object blocks
+// itself, against the CPU's IrradianceVolume::evaluate.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -9,6 +10,8 @@
 
 #include "lumar/base/constants.h"
 #include "lumar/base/error.h"
+#include "lumar/lighting/irradiance_volume.h"
+#include "lumar/lighting/room_radiance.h"
 #include "lumar/render/renderer.h"
 #include "render_test_util.h"
 
@@ -149,6 +152,43 @@ TEST(CompositeFeatures, SelfOcclusionLightsTheOpenShareFromTheBentNormal) {
   EXPECT_NEAR(bent_up, plain, 0.01f);
   EXPECT_NEAR(half, 0.5f * plain, 0.006f);
   EXPECT_THROW(flat.renderer->set_object_self_occlusion(flat.id, std::vector<VertexOcclusion>(3)), InputError);
+}
+
+TEST(CompositeFeatures, TheObjectsOwnShadowDarkensTheExactLightsAtTheNormal) {
+  headless_context();
+  // A dim sky and a sun texel block that the quad (facing +z) sees: a distant volume
+  // whose exact lights hold the sun.
+  const EnvironmentMap map = dim_sky_with_sun();
+  const VolumeSettings settings = volume_settings_for("volume");
+  const IrradianceVolume volume = IrradianceVolume::build_distant(RoomRadiance(map, settings.radiance), settings);
+  ASSERT_FALSE(volume.lights.empty());
+  FlatObject flat(0.0f);
+  flat.renderer->set_irradiance_volume(&volume);
+  const double exposure = 0.05;
+  const cv::Mat black(120, 160, CV_8UC3, cv::Scalar::all(0));
+  const auto centre_value = [&] {
+    return linear_of(flat.renderer->render_overlay(black, flat.pose, exposure)).at<cv::Vec3f>(60, 80)[1];
+  };
+  const glm::dvec3 p(0, 0, -2), n(0, 0, 1), up(0, 1, 0);
+  const auto expected = [&](const glm::dvec3& bent, double open, double lights) {
+    return float(volume.evaluate(p, bent, n, open, lights).g * exposure / kPi);
+  };
+  // Half open, bent up, and the sun's light half blocked, then wholly, then not at all.
+  flat.renderer->set_object_self_occlusion(flat.id, std::vector<VertexOcclusion>(4, VertexOcclusion{{0, 1, 0}, 0.5f}));
+  flat.renderer->set_features({.antialiasing = false, .self_occlusion = true, .noise = false, .blur = false});
+  std::vector<std::pair<float, float>> seen;
+  for (float blocked : {0.5f, 1.0f, 0.0f}) {
+    flat.renderer->set_object_lights_blocked(flat.id, std::vector<float>(4, blocked));
+    seen.push_back({centre_value(), expected(up, 0.5, 1.0 - blocked)});
+    std::printf("lights blocked %.1f: pixel %.4f, CPU %.4f\n", blocked, seen.back().first, seen.back().second);
+    EXPECT_NEAR(seen.back().first, seen.back().second, 0.01f * seen.back().second + 0.002f);
+  }
+  // The sun matters here: wholly blocked is far darker than open.
+  EXPECT_LT(seen[1].first, 0.5f * seen[2].first);
+  // Self-occlusion off: the blocked share and the open share are ignored.
+  flat.renderer->set_features(kNone);
+  EXPECT_NEAR(centre_value(), expected(n, 1.0, 1.0), 0.01f * expected(n, 1.0, 1.0) + 0.002f);
+  EXPECT_THROW(flat.renderer->set_object_lights_blocked(flat.id, std::vector<float>(3)), InputError);
 }
 
 }  // namespace

@@ -96,7 +96,19 @@ std::optional<ObjectHit> CompositeReference::hit_object(const glm::dvec3& origin
 }
 
 ExtraOccluder CompositeReference::objects_as_occluder() const {
-  return [this](const glm::dvec3& q, const glm::dvec3& w, double t_far) { return blocked(q, w, t_far); };
+  return [this](const glm::dvec3& q, const glm::dvec3& w, double t_far) -> std::optional<glm::dvec3> {
+    if (blocked(q, w, t_far)) return glm::dvec3(0.0);
+    return std::nullopt;
+  };
+}
+
+ExtraOccluder CompositeReference::objects_reflecting_onto(int self) const {
+  return [this, self](const glm::dvec3& q, const glm::dvec3& w, double t_far) -> std::optional<glm::dvec3> {
+    const std::optional<ObjectHit> hit = hit_object(q, w, t_far);
+    if (!hit) return std::nullopt;
+    if (hit->object == self || objects_[std::size_t(hit->object)].vertex_irradiance.empty()) return glm::dvec3(0.0);
+    return object_radiance(*hit, false);
+  };
 }
 
 bool CompositeReference::blocked(const glm::dvec3& p, const glm::dvec3& w, double t_far) const {
@@ -118,7 +130,8 @@ glm::dvec3 CompositeReference::object_radiance(const ObjectHit& hit, bool per_po
     // Seen from inside (through a hole in a scanned shell: the figurine's crest, arm and
     // toes), the vertex normals face away: the surface's own normal, towards the viewer.
     const glm::dvec3 n = glm::dot(hit.normal, hit.facing) > 0.0 ? hit.normal : hit.facing;
-    E = reference_irradiance(room_, hit.point, n, hit.facing, settings_.object_strata, objects_as_occluder());
+    E = reference_irradiance(room_, hit.point, n, hit.facing, settings_.object_strata,
+                             settings_.bounce ? objects_reflecting_onto(hit.object) : objects_as_occluder());
   } else {
     const Mesh& m = object.world;
     for (int k = 0; k < 3; ++k) E += hit.weights[k] * object.vertex_irradiance[m.indices[3 * hit.triangle + k]];

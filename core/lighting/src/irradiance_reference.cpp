@@ -86,7 +86,7 @@ glm::dvec3 reference_irradiance(const RoomRadiance& room, const glm::dvec3& poin
     if (!room.sees(p, t.on_proxy, t.position, t.direction)) continue;
     if (occluder) {
       const double reach = t.on_proxy ? glm::length(t.position - p) - 2e-3 : std::numeric_limits<double>::infinity();
-      if (occluder(p, toward, reach)) continue;
+      if (occluder(p, toward, reach)) continue;  // its own light comes with the dim rays
     }
     bright += t.radiance * omega * cosine;
   }
@@ -100,7 +100,11 @@ glm::dvec3 reference_irradiance(const RoomRadiance& room, const glm::dvec3& poin
       const double u1 = (i + jitter(rng)) / strata, u2 = (j + jitter(rng)) / strata;
       const glm::dvec3 w = cosine_direction(n, tangent, bitangent, u1, u2);
       const RoomRadiance::Sample sample = room.dim_radiance(p, w);
-      if (occluder && occluder(p, w, sample.distance)) continue;
+      if (occluder)
+        if (const std::optional<glm::dvec3> back = occluder(p, w, sample.distance)) {
+          dim += *back;
+          continue;
+        }
       dim += sample.radiance;
     }
   // Cosine-weighted sampling: pdf = cos / π, so E = π · mean(L).

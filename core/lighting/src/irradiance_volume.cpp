@@ -562,8 +562,16 @@ IrradianceVolume IrradianceVolume::blend(const IrradianceVolume& from, const Irr
   return out;
 }
 
-glm::dvec3 IrradianceVolume::evaluate(const glm::dvec3& p, const glm::dvec3& normal) const {
-  const glm::dvec3 n = glm::normalize(normal);
+glm::dvec3 light_irradiance(const VolumeLight& l, const glm::dvec3& capture, const glm::dvec3& p, const glm::dvec3& n,
+                            glm::dvec3* toward) {
+  const double omega = light_solid_angle(l, capture, p, toward);
+  const double cosine = glm::dot(n, *toward);
+  return omega > 0.0 && cosine > 0.0 ? l.radiance * omega * cosine : glm::dvec3(0.0);
+}
+
+glm::dvec3 IrradianceVolume::evaluate(const glm::dvec3& p, const glm::dvec3& normal, const glm::dvec3& normal_lights,
+                                      double rest_scale, double lights_scale) const {
+  const glm::dvec3 n = glm::normalize(normal), n_lights = glm::normalize(normal_lights);
   const auto probe_irradiance = [&](int k) -> glm::dvec3 {
     glm::dvec3 e(0.0);
     if (settings_.storage != ProbeStorage::octahedral) {
@@ -645,17 +653,15 @@ glm::dvec3 IrradianceVolume::evaluate(const glm::dvec3& p, const glm::dvec3& nor
     }
   }
   if (total <= 0.0) return glm::dvec3(0.0);
-  glm::dvec3 e = sum / total;
+  glm::dvec3 exact(0.0);
   for (std::size_t l = 0; l < L; ++l) {
     const bool mapped = shadow_n > 0 && lights[l].on_proxy;
     const double visibility = mapped ? light_shadow_visibility(l, p) : light_weight[l] / total;
     if (visibility <= 0.0) continue;
     glm::dvec3 toward;
-    const double omega = light_solid_angle(lights[l], capture_position, p, &toward);
-    const double cosine = glm::dot(n, toward);
-    if (omega > 0.0 && cosine > 0.0) e += visibility * lights[l].radiance * omega * cosine;
+    exact += visibility * light_irradiance(lights[l], capture_position, p, n_lights, &toward);
   }
-  return e;
+  return rest_scale * (sum / total) + lights_scale * exact;
 }
 
 }  // namespace lumar

@@ -10,6 +10,7 @@
 #include "lumar/base/error.h"
 #include "lumar/lighting/irradiance_scene.h"
 #include "lumar/lighting/irradiance_volume.h"
+#include "lumar/lighting/light_self_shadow.h"
 #include "lumar/lighting/self_occlusion.h"
 #include "lumar/lighting/shadows/object_bounce.h"
 #include "lumar/lighting/shadows/object_shadows.h"
@@ -53,6 +54,8 @@ Compositor::Compositor(std::shared_ptr<const LoadedScene> scene, const CameraInt
     spdlog::debug("object '{}': {} triangles", object.name, mesh.triangle_count());
   }
   vertex_light_stale_.assign(s.objects.size(), 1);
+  lights_blocked_.assign(s.objects.size(), {});
+  lights_blocked_stale_.assign(s.objects.size(), 1);
   pose_object_points();
   build_shadows();
   set_features(renderer_->features());
@@ -70,6 +73,7 @@ void Compositor::bake_self_occlusion_once() {
   for (std::size_t i = 0; i < scene_->objects.size(); ++i) {
     self_occlusion_.push_back(bake_self_occlusion(scene_->objects[i].model));
     renderer_->set_object_self_occlusion(int(i), self_occlusion_.back());
+    light_self_shadow_.push_back(std::make_shared<const LightSelfShadow>(scene_->objects[i].model));
   }
   spdlog::debug("self-occlusion baked in {:.0f} ms",
                 std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
@@ -91,6 +95,7 @@ void Compositor::set_features(const gl::CompositeFeatures& features) {
   if (before.self_occlusion != features.self_occlusion) {
     give_bounce_occlusion();
     std::fill(vertex_light_stale_.begin(), vertex_light_stale_.end(), 1);
+    std::fill(lights_blocked_stale_.begin(), lights_blocked_stale_.end(), 1);
   }
   if (before.bounce != features.bounce) shadows_uploaded_ = false;
 }
@@ -164,6 +169,7 @@ void Compositor::move_object(std::size_t index, const glm::dmat4& T_world_model)
   poses_[index] = T_world_model;
   pose_object_points();
   vertex_light_stale_[index] = 1;
+  lights_blocked_stale_[index] = 1;
   if (shadows_) shadows_->set_object_pose(int(index), T_world_model);
   if (object_shadows_) object_shadows_->set_object_pose(int(index), T_world_model);
   if (bounce_) bounce_->set_object_pose(int(index), T_world_model);
@@ -178,6 +184,7 @@ void Compositor::set_lighting(const SceneLighting& lighting) {
   for (std::size_t i = 0; i < scene_->objects.size(); ++i) renderer_->set_object_material(int(i), albedo_.at(i), sh_);
   light_scale_ = lighting.scale;
   std::fill(vertex_light_stale_.begin(), vertex_light_stale_.end(), 1);
+  std::fill(lights_blocked_stale_.begin(), lights_blocked_stale_.end(), 1);
   relight_shadows();
 }
 
@@ -205,6 +212,18 @@ void Compositor::set_object_shading(ObjectShading shading) {
   std::fill(vertex_light_stale_.begin(), vertex_light_stale_.end(), 1);
 }
 
+// With self-occlusion on, the stale objects' shadows on themselves from the exact lights.
+void Compositor::shadow_objects_themselves(FrameLight& light) {
+  light.lights_blocked.assign(scene_->objects.size(), std::nullopt);
+  if (!renderer_->features().self_occlusion || light_self_shadow_.empty() || !volume_) return;
+  for (std::size_t i = 0; i < scene_->objects.size(); ++i) {
+    if (!lights_blocked_stale_[i]) continue;
+    lights_blocked_[i] = light_self_shadow_[i]->blocked(poses_[i], volume_->lights, volume_->capture_position);
+    light.lights_blocked[i] = lights_blocked_[i];
+    lights_blocked_stale_[i] = 0;
+  }
+}
+
 // Per-vertex shading: the stale objects' light from the volume, with their self-occlusion when it is on.
 void Compositor::light_vertices(FrameLight& light) {
   light.vertex_irradiance.assign(scene_->objects.size(), std::nullopt);
@@ -214,7 +233,9 @@ void Compositor::light_vertices(FrameLight& light) {
     if (!vertex_light_stale_[i]) continue;
     const std::span<const VertexOcclusion> occlusion =
         occluded ? std::span<const VertexOcclusion>(self_occlusion_[i]) : std::span<const VertexOcclusion>();
-    light.vertex_irradiance[i] = vertex_irradiance(scene_->objects[i].model, poses_[i], occlusion, *volume_);
+    const std::span<const float> blocked =
+        occluded && !light_self_shadow_.empty() ? std::span<const float>(lights_blocked_[i]) : std::span<const float>();
+    light.vertex_irradiance[i] = vertex_irradiance(scene_->objects[i].model, poses_[i], occlusion, blocked, *volume_);
     vertex_light_stale_[i] = 0;
   }
 }
@@ -293,6 +314,7 @@ FrameLight Compositor::prepare() {
       light.object_shadowing.push_back(object_shadows_->vertex_attenuation(int(i)));
     object_shadows_uploaded_ = true;
   }
+  shadow_objects_themselves(light);
   const auto t1 = std::chrono::steady_clock::now();
   light_vertices(light);
   light.shadows_ms = std::chrono::duration<double, std::milli>(t1 - t0).count();
@@ -303,6 +325,7 @@ FrameLight Compositor::prepare() {
 void Compositor::forget_prepared() {
   shadows_uploaded_ = object_shadows_uploaded_ = false;
   std::fill(vertex_light_stale_.begin(), vertex_light_stale_.end(), 1);
+  std::fill(lights_blocked_stale_.begin(), lights_blocked_stale_.end(), 1);
 }
 
 cv::Mat Compositor::render(const FrameLight& light, const cv::Mat& video_bgr8,
@@ -315,6 +338,8 @@ cv::Mat Compositor::render(const FrameLight& light, const cv::Mat& video_bgr8,
     renderer_->set_object_light_attenuation(int(i), light.object_shadowing[i]);
   for (std::size_t i = 0; i < light.vertex_irradiance.size(); ++i)
     if (light.vertex_irradiance[i]) renderer_->set_object_vertex_irradiance(int(i), *light.vertex_irradiance[i]);
+  for (std::size_t i = 0; i < light.lights_blocked.size(); ++i)
+    if (light.lights_blocked[i]) renderer_->set_object_lights_blocked(int(i), *light.lights_blocked[i]);
   if (timings) {
     *timings = {};
     timings->shadows_ms = light.shadows_ms;

@@ -71,6 +71,10 @@ void GpuMesh::set_vertex_irradiance(std::span<const glm::vec3> irradiance) {
   update_attribute(irradiance_, 5, 3, irradiance.data(), irradiance.size(), "vertex irradiance");
 }
 
+void GpuMesh::set_lights_blocked(std::span<const float> blocked) {
+  update_attribute(lights_blocked_, 6, 1, blocked.data(), blocked.size(), "light self-shadow");
+}
+
 void GpuMesh::draw(int level) const {
   if (empty()) return;
   const Level& l = levels_[std::size_t(level)];

@@ -90,7 +90,9 @@ float volume_light_shadow(int l, vec3 p) {
   return mix(mix(a, b, f.x), mix(c, d, f.x), f.y);
 }
 
-vec3 volume_irradiance(vec3 p, vec3 n) {
+// IrradianceVolume::evaluate: the probes' light at n times rest_scale, plus the exact
+// lights at n_lights times lights_scale.
+vec3 volume_irradiance(vec3 p, vec3 n, vec3 n_lights, float rest_scale, float lights_scale) {
   float light_weight[16];
   for (int l = 0; l < 16; ++l) light_weight[l] = 0.0;
   vec3 sum = vec3(0.0);
@@ -155,7 +157,7 @@ vec3 volume_irradiance(vec3 p, vec3 n) {
     }
   }
   if (total <= 0.0) return vec3(0.0);
-  vec3 result = sum / total;
+  vec3 exact = vec3(0.0);
   for (int l = 0; l < volume_light_count; ++l) {
     bool mapped = volume_shadow_n > 0 && volume_light_direction[l].w != 0.0;
     float visibility = mapped ? volume_light_shadow(l, p) : light_weight[l] / total;
@@ -175,10 +177,10 @@ vec3 volume_irradiance(vec3 p, vec3 n) {
       float cos_c = max(dot(volume_light_normal[l], vc) / sqrt(rc2), 1e-3);
       omega = min(omega * rc2 / r2 * cos_p / cos_c, 6.28318530717959);
     }
-    float cosine = dot(n, toward);
-    if (omega > 0.0 && cosine > 0.0) result += visibility * volume_light_radiance[l].rgb * omega * cosine;
+    float cosine = dot(n_lights, toward);
+    if (omega > 0.0 && cosine > 0.0) exact += visibility * volume_light_radiance[l].rgb * omega * cosine;
   }
-  return result;
+  return rest_scale * (sum / total) + lights_scale * exact;
 }
 )glsl";
 

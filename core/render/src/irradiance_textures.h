@@ -9,7 +9,7 @@
 namespace lumar::gl {
 
 // GLSL appended to the shaded-object fragment shader: defines
-// vec3 volume_irradiance(vec3 p, vec3 n). Texture units 8..15.
+// vec3 volume_irradiance(vec3 p, vec3 n, vec3 n_lights, float rest_scale, float lights_scale). Texture units 8..15.
 extern const char* const kIrradianceVolumeGlsl;
 
 class IrradianceTextures {

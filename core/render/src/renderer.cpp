@@ -468,6 +468,11 @@ void Renderer::set_object_vertex_irradiance(int id, std::span<const glm::vec3> i
   check_gl_errors("Renderer::set_object_vertex_irradiance");
 }
 
+void Renderer::set_object_lights_blocked(int id, std::span<const float> blocked) {
+  impl_->object(id, "set_object_lights_blocked").mesh.set_lights_blocked(blocked);
+  check_gl_errors("Renderer::set_object_lights_blocked");
+}
+
 void Renderer::set_object_self_occlusion(int id, std::span<const VertexOcclusion> occlusion) {
   std::vector<glm::vec4> packed(occlusion.size());
   for (std::size_t i = 0; i < occlusion.size(); ++i) packed[i] = glm::vec4(occlusion[i].bent_normal, occlusion[i].open);

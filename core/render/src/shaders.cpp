@@ -19,6 +19,7 @@ layout(location = 2) in vec3 light_attenuation;  // objects: what other objects 
 layout(location = 3) in vec4 occlusion;          // objects: bent normal (model space), open share
 layout(location = 4) in vec3 bounce_light;       // objects: irradiance the other objects reflect onto it
 layout(location = 5) in vec3 vertex_irradiance;  // objects shaded per vertex: E(bent normal) x open share
+layout(location = 6) in float light_blocked;     // objects: the share of the exact lights they block themselves
 uniform mat4 model;
 uniform mat3 normal_matrix;
 uniform mat4 view_projection;
@@ -28,6 +29,7 @@ out vec3 attenuation;
 out vec4 self_occlusion;
 out vec3 bounce;
 out vec3 lit;
+out float lights_blocked;
 // The objects' depth pre-pass and their shaded pass must agree to the bit (GL_LEQUAL).
 invariant gl_Position;
 void main() {
@@ -38,6 +40,7 @@ void main() {
   self_occlusion = vec4(normal_matrix * occlusion.xyz, occlusion.w);
   bounce = bounce_light;
   lit = vertex_irradiance;
+  lights_blocked = light_blocked;
   gl_Position = view_projection * w;
 }
 )glsl";
@@ -93,13 +96,14 @@ in vec3 attenuation;
 in vec4 self_occlusion;  // bent normal (world; zero when not baked), open share
 in vec3 bounce;          // irradiance the other objects reflect onto this point
 in vec3 lit;             // the object's light per vertex (lighting/vertex_irradiance.h)
+in float lights_blocked; // the share of the exact lights the object blocks itself (lighting/light_self_shadow.h)
 uniform vec3 albedo;
 uniform float exposure;
 uniform vec3 sh[9];  // L00, L1-1, L10, L11, L2-2, L2-1, L20, L21, L22 (world frame)
 uniform bool use_volume;  // irradiance volume (gl/irradiance_textures.cpp) instead of sh
 uniform bool use_self_occlusion;
 uniform bool use_vertex_irradiance;  // `lit` already holds the volume's light and the self-occlusion
-vec3 volume_irradiance(vec3 p, vec3 n);
+vec3 volume_irradiance(vec3 p, vec3 n, vec3 n_lights, float rest_scale, float lights_scale);
 vec3 sh9_irradiance(vec3 L0, vec3 L1, vec3 L2, vec3 L3, vec3 L4, vec3 L5, vec3 L6, vec3 L7, vec3 L8, vec3 n);
 out vec4 color;
 
@@ -108,17 +112,21 @@ vec3 sh_irradiance(vec3 n) { return sh9_irradiance(sh[0], sh[1], sh[2], sh[3], s
 void main() {
   vec3 irradiance = lit;
   if (!use_vertex_irradiance) {
-    vec3 n = normalize(world_normal);
-    // The object's own occlusion: the light of the open directions, E(bent normal), times
-    // the open share (lighting/self_occlusion.h).
-    float open = 1.0;
-    if (use_self_occlusion && dot(self_occlusion.xyz, self_occlusion.xyz) > 1e-12) {
-      n = normalize(self_occlusion.xyz);
-      open = clamp(self_occlusion.w, 0.0, 1.0);
+    vec3 n = normalize(world_normal), bent = n;
+    // The object's own occlusion: the room's light of the open directions, E(bent normal),
+    // times the open share (lighting/self_occlusion.h); the exact lights at the normal,
+    // less what the object blocks of them (lighting/light_self_shadow.h).
+    float open = 1.0, lights = 1.0;
+    if (use_self_occlusion) {
+      if (dot(self_occlusion.xyz, self_occlusion.xyz) > 1e-12) {
+        bent = normalize(self_occlusion.xyz);
+        open = clamp(self_occlusion.w, 0.0, 1.0);
+      }
+      lights = 1.0 - clamp(lights_blocked, 0.0, 1.0);
     }
     // Nine coefficients can ring below zero opposite a bright source; light is never negative.
-    irradiance = use_volume ? volume_irradiance(world_position, n) : max(sh_irradiance(n), vec3(0.0));
-    irradiance *= open;
+    irradiance = use_volume ? volume_irradiance(world_position, bent, n, open, lights)
+                            : open * max(sh_irradiance(bent), vec3(0.0));
   }
   irradiance *= clamp(attenuation, 0.0, 1.0);
   irradiance += max(bounce, vec3(0.0));

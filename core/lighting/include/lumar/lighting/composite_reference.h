@@ -1,9 +1,11 @@
 #pragma once
 // Ground truth for a composite (docs/ground_truth.md): the light of the real room with
 // the virtual objects physically in it, by brute force with Embree.
-//  - On an object: albedo/π × E with full visibility. A ray that meets an object (the
-//    same one or another) brings nothing, so objects occlude themselves and each other;
-//    bright texels are summed exactly, each with a visibility ray past proxy and objects.
+//  - On an object: albedo/π × E with full visibility: objects occlude themselves and
+//    each other. A ray that meets the same object brings nothing; one that meets another
+//    brings that object's radiance (one bounce, with `bounce`, as onto the room; else
+//    nothing). Bright texels are summed exactly, each with a visibility ray past proxy
+//    and objects.
 //  - On the room: the empty room's radiance × (E_with + E_bounce) / E_without, where
 //    E_with − E_without is what the objects block and E_bounce what they reflect onto
 //    the room (one bounce, from their own E per vertex). Both are sampled within the cone
@@ -30,7 +32,7 @@ struct CompositeReferenceSettings {
   int room_strata = 12;    // strata² rays for the empty room's E at a room point
   int cone_strata = 8;     // strata² rays into each object's cone per room point
   double reach = 10.0;     // a room point farther than reach × radius from an object ignores it
-  bool bounce = true;      // add the light objects reflect onto the room
+  bool bounce = true;      // add the light objects reflect onto the room and onto each other
 };
 
 struct ObjectHit {
@@ -63,7 +65,8 @@ class CompositeReference {
   // `strata` 0: settings().object_strata.
   glm::dvec3 irradiance_with_objects(const glm::dvec3& p, const glm::dvec3& n, int strata = 0) const;
   // The radiance an object's surface sends towards a viewer at a hit: albedo/π × E at
-  // the hit (the pixel's own integral when `per_point`, else its vertices' interpolated).
+  // the hit (the pixel's own integral when `per_point`, with the other objects' bounce;
+  // else its vertices' E interpolated, which has none: the one bounce's source).
   glm::dvec3 object_radiance(const ObjectHit& hit, bool per_point = true) const;
   // (E_with + E_bounce) / E_without per channel at a room point p with normal n;
   // exactly 1 where every object is out of reach.
@@ -79,8 +82,11 @@ class CompositeReference {
   };
   // Whether an object lies on the segment p + t·w, t in (0, t_far).
   bool blocked(const glm::dvec3& p, const glm::dvec3& w, double t_far) const;
-  // `blocked` in the form reference_irradiance takes.
+  // `blocked` in the form reference_irradiance takes: black objects.
   ExtraOccluder objects_as_occluder() const;
+  // Objects that send back their one-bounce radiance (object_radiance per vertex), but
+  // object `self`, black: a point's light from the others.
+  ExtraOccluder objects_reflecting_onto(int self) const;
 
   const RoomRadiance& room_;
   CompositeReferenceSettings settings_;

@@ -8,6 +8,7 @@
 //    traced against the proxy (exact visibility).
 #include <functional>
 #include <glm/glm.hpp>
+#include <optional>
 #include <span>
 #include <vector>
 
@@ -27,12 +28,13 @@ RadianceSettings reference_radiance_settings();
 // E(p, n) with strata × strata cosine-weighted rays (one jittered ray per stratum,
 // seeded by the query so results are reproducible).
 glm::dvec3 reference_irradiance(const RoomRadiance& room, const glm::dvec3& p, const glm::dvec3& n, int strata = 64);
-// Whether something besides the proxy lies on p + t·w (w unit) for t in (0, t_far);
-// t_far infinite: out to infinity. Virtual objects, for composite_reference.h.
-using ExtraOccluder = std::function<bool(const glm::dvec3& p, const glm::dvec3& w, double t_far)>;
-// The same with `occluder` blocking rays and bright texels too (none when empty); rays
-// start off the surface along `off_surface` (a geometric normal where `normal` is a
-// shading normal).
+// Something besides the proxy on p + t·w (w unit) for t in (0, t_far) (t_far infinite:
+// out to infinity): the radiance it sends back along the ray (0 when black), or nullopt
+// when nothing is there. Virtual objects, for composite_reference.h.
+using ExtraOccluder = std::function<std::optional<glm::dvec3>(const glm::dvec3& p, const glm::dvec3& w, double t_far)>;
+// The same with `occluder` blocking rays and bright texels too (none when empty), a
+// blocked ray bringing the occluder's radiance instead of the room's; rays start off the
+// surface along `off_surface` (a geometric normal where `normal` is a shading normal).
 glm::dvec3 reference_irradiance(const RoomRadiance& room, const glm::dvec3& p, const glm::dvec3& normal,
                                 const glm::dvec3& off_surface, int strata, const ExtraOccluder& occluder);
 // Many queries at once (parallel over queries).

@@ -31,15 +31,15 @@ enum class ProbeStorage : int { sh9 = 0, octahedral = 1, sh9_octahedral = 2 };
 
 struct VolumeSettings {
   ProbeStorage storage = ProbeStorage::sh9_octahedral;
-  int octahedral_resolution = 12;  // texels per side of the octahedral map
-  bool separate_lights = true;     // dominant lights evaluated per pixel (shadow maps), not stored
+  int octahedral_resolution = 12;   // texels per side of the octahedral map
+  bool separate_lights = true;      // dominant lights evaluated per pixel (shadow maps), not stored
   int shadow_map_resolution = 128;  // texels per side of each exact light's shadow map: ~1.4 degrees at 128
-  int rays_per_probe = 512;        // for the radiance below the bright threshold
-  int depth_resolution = 8;        // distance-moment texels per side
-  double spacing = 0.3;            // largest cell edge of the uniform level, metres
-  bool refine = true;              // one adaptive level near geometry
-  bool visibility = true;          // Chebyshev and back-face weights
-  RadianceSettings radiance;       // bright texels and dominant lights
+  int rays_per_probe = 512;         // for the radiance below the bright threshold
+  int depth_resolution = 8;         // distance-moment texels per side
+  double spacing = 0.3;             // largest cell edge of the uniform level, metres
+  bool refine = true;               // one adaptive level near geometry
+  bool visibility = true;           // Chebyshev and back-face weights
+  RadianceSettings radiance;        // bright texels and dominant lights
 
   std::string describe() const;
 };
@@ -62,6 +62,11 @@ struct VolumeLight {
   glm::dvec3 position{0.0}, normal{0.0};
 };
 
+// The irradiance light l gives at world point p with unit normal n before anything blocks
+// it (0 behind the point or the light), and the unit direction it comes from.
+glm::dvec3 light_irradiance(const VolumeLight& l, const glm::dvec3& capture, const glm::dvec3& p, const glm::dvec3& n,
+                            glm::dvec3* toward);
+
 class IrradianceVolume {
  public:
   // One probe, no grid: a distant map (position is ignored by evaluate).
@@ -76,7 +81,13 @@ class IrradianceVolume {
   static IrradianceVolume blend(const IrradianceVolume& from, const IrradianceVolume& to, double t);
 
   // Irradiance at world point p with unit normal n.
-  glm::dvec3 evaluate(const glm::dvec3& p, const glm::dvec3& n) const;
+  glm::dvec3 evaluate(const glm::dvec3& p, const glm::dvec3& n) const { return evaluate(p, n, n, 1.0, 1.0); }
+  // The same in two parts: the probes' light (the room but the exact lights) at normal n
+  // times rest_scale, plus the exact lights at normal n_lights times lights_scale. An
+  // object's own occlusion darkens the two differently (self_occlusion.h for the rest,
+  // light_self_shadow.h for the lights).
+  glm::dvec3 evaluate(const glm::dvec3& p, const glm::dvec3& n, const glm::dvec3& n_lights, double rest_scale,
+                      double lights_scale) const;
 
   // Disk format (binary, versioned); save writes atomically. load throws InputError.
   void save(const std::filesystem::path& file) const;

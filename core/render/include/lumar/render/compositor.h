@@ -19,6 +19,7 @@ class LineShadows;
 class ObjectShadows;
 class ObjectBounce;
 class IrradianceVolume;
+class LightSelfShadow;
 struct VertexOcclusion;
 
 // The shadows' quality knobs (docs/shadows.md): how many emitter patches the map is split
@@ -49,6 +50,7 @@ struct FrameLight {
   std::vector<std::vector<glm::vec3>> object_bounce;                     // per object: the others' light on it
   std::vector<std::vector<glm::vec3>> object_shadowing;                  // per object: the others' shadow on it
   std::vector<std::optional<std::vector<glm::vec3>>> vertex_irradiance;  // per object (ObjectShading::PerVertex)
+  std::vector<std::optional<std::vector<float>>> lights_blocked;         // per object: its shadow on itself
   double shadows_ms = 0, vertex_light_ms = 0;
 };
 
@@ -145,10 +147,16 @@ class Compositor {
   void bake_self_occlusion_once();
   void give_bounce_occlusion();
   std::vector<std::vector<VertexOcclusion>> self_occlusion_;  // per object, once baked
-  std::vector<glm::dmat4> poses_;                             // T_world_model per object
-  std::vector<glm::vec3> albedo_;                             // per object
-  std::vector<std::vector<glm::dvec3>> sampled_points_;       // per object, model coordinates
-  std::vector<glm::dvec3> object_points_;                     // the above, posed
+  // Per object, with self-occlusion on: its shadow on itself from the volume's exact
+  // lights, for its current pose (again when it moves or the room is relit).
+  std::vector<std::shared_ptr<const LightSelfShadow>> light_self_shadow_;  // built with the bake
+  std::vector<std::vector<float>> lights_blocked_;
+  std::vector<char> lights_blocked_stale_;
+  void shadow_objects_themselves(FrameLight& light);
+  std::vector<glm::dmat4> poses_;                        // T_world_model per object
+  std::vector<glm::vec3> albedo_;                        // per object
+  std::vector<std::vector<glm::dvec3>> sampled_points_;  // per object, model coordinates
+  std::vector<glm::dvec3> object_points_;                // the above, posed
   void pose_object_points();
   std::shared_ptr<LineShadows> shadows_;  // shared_ptr: LineShadows is incomplete here
   std::shared_ptr<ObjectShadows> object_shadows_;

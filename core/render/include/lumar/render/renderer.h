@@ -97,6 +97,11 @@ class Renderer {
   // Per vertex (mesh order), the object's occlusion of itself (bake_self_occlusion);
   // unset, the object is open everywhere. Throws InputError unless one value per vertex.
   void set_object_self_occlusion(int id, std::span<const VertexOcclusion> occlusion);
+  // Per vertex (mesh order), the share of the volume's exact lights the object blocks
+  // itself in its current pose (LightSelfShadow::blocked); shaded with self-occlusion on,
+  // it darkens those lights, at the vertex's own normal, instead of the open share.
+  // Unset: nothing blocked. Same rules as set_object_light_attenuation.
+  void set_object_lights_blocked(int id, std::span<const float> blocked);
   // Shade every object per pixel from this irradiance volume (uploaded as textures;
   // core/irradiance_volume.h) instead of its SH9; nullptr goes back to SH9. A volume of
   // the current one's layout (the same room relit) only updates its light.
