@@ -5,6 +5,7 @@
 #include "lumar/base/color.h"
 #include "lumar/base/error.h"
 #include "lumar/lighting/ray_scene.h"
+#include "lumar/lighting/self_occlusion.h"
 
 namespace lumar {
 
@@ -13,9 +14,9 @@ LightSelfShadow::LightSelfShadow(const Mesh& model) : model_(model), scene_(std:
     throw InputError("LightSelfShadow: the mesh needs one normal per vertex; load it with load_mesh");
   scene_->add_static(model_);
   scene_->commit();
-  // As the self-occlusion bake starts its rays (SelfOcclusionSettings::offset).
+  // Where the self-occlusion bake starts its rays.
   const auto [lo, hi] = model_.bounds();
-  offset_ = float(1e-4 * glm::length(glm::dvec3(hi) - glm::dvec3(lo)));
+  offset_ = float(SelfOcclusionSettings{}.offset * glm::length(glm::dvec3(hi) - glm::dvec3(lo)));
 }
 
 LightSelfShadow::~LightSelfShadow() = default;
