@@ -139,6 +139,7 @@ void register_commands(CLI::App& app) {
   register_envmap(app);
   register_shadows(app);
   register_irradiance(app);
+  register_solidify(app);
 }
 
 void run_selected(CLI::App& app) {

@@ -47,6 +47,8 @@ void apply_composite_options(const CompositeOptions& o, pipeline::OverlaySetting
 std::optional<pipeline::QualityBudget> auto_quality(const CompositeOptions& o);
 
 void register_synth(CLI::App& app);
+// `lumar solidify`: a closed solid around an open scan.
+void register_solidify(CLI::App& app);
 void register_overlay(CLI::App& app);
 void register_regress(CLI::App& app);
 void register_calibrate(CLI::App& app);

@@ -17,6 +17,7 @@ packages=(
   libcli11-dev nlohmann-json3-dev libspdlog-dev libfmt-dev
   libassimp-dev                      # OBJ, PLY, glTF meshes
   libmeshoptimizer-dev               # coarser versions of the objects, drawn when small on screen
+  libcgal-dev                        # closed solids around open scans (alpha wrapping): lumar solidify
   zlib1g-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   libimgui-dev libstb-dev            # Dear ImGui (with its GLFW and OpenGL 3 backends): the window's panels

@@ -11,7 +11,9 @@ out = pathlib.Path(__file__).resolve().parent.parent / "data" / "scenes" / "cour
 def write(name, comment, verts, faces):
     with open(out / name, "w") as f:
         f.write(f"# {comment} Written by scripts/make_courtyard_meshes.py.\n")
-        f.writelines(f"v {x:g} {y:g} {z:g}\n" for x, y, z in verts)
+        # Rounded, so that a pole's copies are one point (sin(pi) is 1.2e-16, not 0): the
+        # sphere is closed (tests/solid, ShippedModels).
+        f.writelines("v %s %s %s\n" % tuple(f"{round(c, 12) + 0.0:g}" for c in v) for v in verts)
         f.writelines(f"f {a} {b} {c}\n" for a, b, c in faces)
 
 

@@ -23,7 +23,7 @@ case_malformed_scene_json() {
 case_corrupt_model() {
   copy_scene
   head -c 3000 /dev/urandom >"$TMP/broken.ply"
-  sed -i "s#\"$SRC/data/models/parasaurolophus_6700.ply\"#\"$TMP/broken.ply\"#" "$TMP/scene.json"
+  sed -i "s#\"$SRC/data/models/parasaurolophus_solid.ply\"#\"$TMP/broken.ply\"#" "$TMP/scene.json"
   expect_bad_input "$TMP/broken.ply" "$TMP/out.mp4" -- \
     "$LUMAR" overlay --recording "$REC" --scene "$TMP/scene.json" --out "$TMP/out.mp4"
 }
@@ -160,7 +160,7 @@ case_png_named_exr_as_environment_map() {
 case_degenerate_object_mesh() {
   copy_scene
   printf 'v 1 1 1\nv 1 1 1\nv 1 1 1\nf 1 2 3\n' >"$TMP/point.obj"
-  sed -i "s#\"$SRC/data/models/parasaurolophus_6700.ply\"#\"$TMP/point.obj\"#" "$TMP/scene.json"
+  sed -i "s#\"$SRC/data/models/parasaurolophus_solid.ply\"#\"$TMP/point.obj\"#" "$TMP/scene.json"
   expect_bad_input "point.obj: mesh is degenerate" "$TMP/out.mp4" -- \
     "$LUMAR" overlay --recording "$REC" --scene "$TMP/scene.json" --out "$TMP/out.mp4"
 }

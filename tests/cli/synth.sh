@@ -61,8 +61,8 @@ for region in ("object", "edge", "shadow"):
     assert floor < err < 50, "%s error %s (floor %s)" % (region, err, floor)
 assert 0.2 < r["noise_ratio"] < 5, r["noise_ratio"]
 # Antialiasing and self-occlusion close part of the gap (docs/ground_truth.md). Dark specks
-# the truth has not: counted (the scan's holes make the same specks in both: 0-1 here).
-assert isinstance(r["specks"], int) and 0 <= r["specks"] <= 10, r["specks"]
+# the truth has not: none on the closed figurine (the open scan gave 1-2; docs/solid.md).
+assert r["specks"] == 0, r["specks"]
 for region in ("object", "edge"):
     assert r["%s_err" % region] < 0.8 * r["all_off_%s_err" % region], region
 print("ok:", {k: round(r[k], 2) for k in keys[1:]})

@@ -166,10 +166,10 @@ TEST(TruthFrame, PerPixelObjectsConvergeAndVertexShadingIsCoarser) {
   EXPECT_LT(noise, 0.03);
   EXPECT_GT(coarse, noise);
   // Specks: figurine pixels below a quarter of the median of their 3×3 neighbours. The
-  // scan has holes (crest, arm, toes) through which rays see the inside of its shell, dark
-  // and lit from the other side; that is what a hollow shell would show, and every speck
-  // must be such a pixel. (Rays that slip through cracks are the sphere tests' concern.)
-  int specks = 0, holes = 0;
+  // scan had holes (crest, arm, toes) through which rays saw the inside of its shell, dark
+  // and lit from the other side: 37 such pixels here. The scenes' figurine is now closed
+  // (docs/solid.md): none. (Rays that slip through cracks are the sphere tests' concern.)
+  int specks = 0;
   for (int r = 1; r + 1 < camera.height; ++r)
     for (int c = 1; c + 1 < camera.width; ++c) {
       if (pixel.coverage.at<float>(r, c) == 0) continue;
@@ -180,16 +180,9 @@ TEST(TruthFrame, PerPixelObjectsConvergeAndVertexShadingIsCoarser) {
             around.push_back(pixel.radiance.at<cv::Vec3f>(r + dr, c + dc)[1]);
       if (around.size() < 4) continue;
       std::nth_element(around.begin(), around.begin() + around.size() / 2, around.end());
-      if (pixel.radiance.at<cv::Vec3f>(r, c)[1] >= 0.25f * around[around.size() / 2]) continue;
-      const glm::dvec3 d =
-          glm::normalize(pose.rotation * glm::dvec3((c - camera.cx) / camera.fx, (r - camera.cy) / camera.fy, 1.0));
-      const auto hit = reference.hit_object(pose.translation, d);
-      ASSERT_TRUE(hit.has_value());
-      (glm::dot(hit->normal, hit->facing) < 0 ? holes : specks)++;
+      if (pixel.radiance.at<cv::Vec3f>(r, c)[1] < 0.25f * around[around.size() / 2]) ++specks;
     }
-  std::printf("%d dark pixels inside the scan's holes, %d elsewhere\n", holes, specks);
   EXPECT_EQ(specks, 0);
-  EXPECT_LT(holes, pixels / 50);
 }
 
 TEST(TruthFrame, SynthWritesTheVideoWithTheObjectsInItAndItsNoiseFloor) {

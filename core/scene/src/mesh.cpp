@@ -4,13 +4,17 @@
 #include <assimp/scene.h>
 
 #include <algorithm>
+#include <assimp/Exporter.hpp>
 #include <assimp/Importer.hpp>
 #include <cmath>
 #include <limits>
+#include <map>
+#include <tuple>
 
 #include "decode_counter.h"
 #include "lumar/base/error.h"
 #include "lumar/base/input_file.h"
+#include "lumar/base/output_file.h"
 #include "ply_check.h"
 
 namespace lumar {
@@ -18,25 +22,6 @@ namespace lumar {
 namespace {
 
 bool is_finite(const glm::vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
-
-// Area-weighted vertex normals: the unnormalised cross product of a triangle's edges
-// has length twice its area, so summing them weights each face by its area.
-std::vector<glm::vec3> area_weighted_normals(const std::vector<glm::vec3>& positions,
-                                             const std::vector<std::uint32_t>& indices) {
-  std::vector<glm::dvec3> sum(positions.size(), glm::dvec3(0.0));
-  for (std::size_t t = 0; t + 2 < indices.size(); t += 3) {
-    const glm::dvec3 a = positions[indices[t]], b = positions[indices[t + 1]], c = positions[indices[t + 2]];
-    const glm::dvec3 n = glm::cross(b - a, c - a);
-    for (int k = 0; k < 3; ++k) sum[indices[t + k]] += n;
-  }
-  std::vector<glm::vec3> normals(positions.size());
-  for (std::size_t i = 0; i < sum.size(); ++i) {
-    const double len = glm::length(sum[i]);
-    // A vertex on no (or only degenerate) triangles has no direction; any unit vector will do.
-    normals[i] = len > 0.0 ? glm::vec3(sum[i] / len) : glm::vec3(0.f, 1.f, 0.f);
-  }
-  return normals;
-}
 
 }  // namespace
 
@@ -141,6 +126,75 @@ Mesh transformed(const Mesh& mesh, const glm::dmat4& m) {
   if (glm::determinant(glm::dmat3(m)) < 0.0)
     for (std::size_t t = 0; t + 2 < out.indices.size(); t += 3) std::swap(out.indices[t + 1], out.indices[t + 2]);
   return out;
+}
+
+// The unnormalised cross product of a triangle's edges
+// has length twice its area, so summing them weights each face by its area.
+std::vector<glm::vec3> area_weighted_normals(const std::vector<glm::vec3>& positions,
+                                             const std::vector<std::uint32_t>& indices) {
+  std::vector<glm::dvec3> sum(positions.size(), glm::dvec3(0.0));
+  for (std::size_t t = 0; t + 2 < indices.size(); t += 3) {
+    const glm::dvec3 a = positions[indices[t]], b = positions[indices[t + 1]], c = positions[indices[t + 2]];
+    const glm::dvec3 n = glm::cross(b - a, c - a);
+    for (int k = 0; k < 3; ++k) sum[indices[t + k]] += n;
+  }
+  std::vector<glm::vec3> normals(positions.size());
+  for (std::size_t i = 0; i < sum.size(); ++i) {
+    const double len = glm::length(sum[i]);
+    // A vertex on no (or only degenerate) triangles has no direction; any unit vector will do.
+    normals[i] = len > 0.0 ? glm::vec3(sum[i] / len) : glm::vec3(0.f, 1.f, 0.f);
+  }
+  return normals;
+}
+
+std::size_t open_edge_count(const Mesh& mesh) {
+  // Vertices at the same position are one: a box's corners are repeated with each face's
+  // normal, and the seam between them is not a crack.
+  std::map<std::tuple<float, float, float>, std::uint32_t> at;
+  std::vector<std::uint32_t> id(mesh.positions.size());
+  for (std::size_t v = 0; v < mesh.positions.size(); ++v) {
+    const glm::vec3& p = mesh.positions[v];
+    id[v] = at.try_emplace({p.x, p.y, p.z}, std::uint32_t(at.size())).first->second;
+  }
+  std::map<std::pair<std::uint32_t, std::uint32_t>, int> uses;
+  for (std::size_t t = 0; t + 2 < mesh.indices.size(); t += 3) {
+    const std::uint32_t v[3] = {id[mesh.indices[t]], id[mesh.indices[t + 1]], id[mesh.indices[t + 2]]};
+    if (v[0] == v[1] || v[1] == v[2] || v[2] == v[0]) continue;  // a fan's tip at a pole: no area, no edge
+    for (int k = 0; k < 3; ++k) ++uses[std::minmax(v[k], v[(k + 1) % 3])];
+  }
+  return std::size_t(std::count_if(uses.begin(), uses.end(), [](const auto& e) { return e.second == 1; }));
+}
+
+void save_mesh_ply(const std::filesystem::path& path, const Mesh& mesh) {
+  // aiScene owns (and frees) what is attached to it.
+  aiScene scene;
+  scene.mRootNode = new aiNode();
+  scene.mRootNode->mNumMeshes = 1;
+  scene.mRootNode->mMeshes = new unsigned[1]{0};
+  scene.mNumMaterials = 1;
+  scene.mMaterials = new aiMaterial* [1] { new aiMaterial() };
+  scene.mNumMeshes = 1;
+  scene.mMeshes = new aiMesh* [1] { new aiMesh() };
+  aiMesh& out = *scene.mMeshes[0];
+  out.mPrimitiveTypes = aiPrimitiveType_TRIANGLE;
+  out.mNumVertices = unsigned(mesh.positions.size());
+  out.mVertices = new aiVector3D[out.mNumVertices];
+  out.mNormals = new aiVector3D[out.mNumVertices];
+  for (unsigned v = 0; v < out.mNumVertices; ++v) {
+    const glm::vec3 p = mesh.positions[v], n = v < mesh.normals.size() ? mesh.normals[v] : glm::vec3(0.f);
+    out.mVertices[v] = aiVector3D(p.x, p.y, p.z);
+    out.mNormals[v] = aiVector3D(n.x, n.y, n.z);
+  }
+  out.mNumFaces = unsigned(mesh.triangle_count());
+  out.mFaces = new aiFace[out.mNumFaces];
+  for (unsigned f = 0; f < out.mNumFaces; ++f) {
+    out.mFaces[f].mNumIndices = 3;
+    out.mFaces[f].mIndices = new unsigned[3]{mesh.indices[3 * f], mesh.indices[3 * f + 1], mesh.indices[3 * f + 2]};
+  }
+  Assimp::Exporter exporter;
+  const aiExportDataBlob* blob = exporter.ExportToBlob(&scene, "plyb");
+  if (!blob) throw RuntimeError(path.string() + ": cannot write the mesh (" + exporter.GetErrorString() + ")");
+  write_file_atomically(path, std::string_view(static_cast<const char*>(blob->data), blob->size));
 }
 
 }  // namespace lumar

@@ -25,4 +25,16 @@ Mesh load_mesh(const std::filesystem::path& path);
 // The mesh with positions mapped by `m` and normals by its inverse transpose.
 Mesh transformed(const Mesh& mesh, const glm::dmat4& m);
 
+// Unit vertex normals, each the area-weighted sum of its triangles' normals.
+std::vector<glm::vec3> area_weighted_normals(const std::vector<glm::vec3>& positions,
+                                             const std::vector<std::uint32_t>& indices);
+
+// Edges that only one triangle uses (vertices at one position count as one): cracks and
+// holes. A closed surface has none. A scan stitched from patches has many, and the
+// renderer shows back faces, and a ray the hollow inside, through them (docs/solid.md).
+std::size_t open_edge_count(const Mesh& mesh);
+
+// Writes the mesh as binary PLY (positions, normals, triangles), whole or not at all.
+void save_mesh_ply(const std::filesystem::path& path, const Mesh& mesh);
+
 }  // namespace lumar
