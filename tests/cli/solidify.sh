@@ -27,3 +27,5 @@ case_bad_input() {
   expect_bad_input "scan.ply" "" -- "$LUMAR" solidify "$TMP/scan.ply" --out "$TMP/scan.ply"
   cmp -s "$SCAN" "$TMP/scan.ply" || fail "the input was overwritten"
 }
+
+run_case
