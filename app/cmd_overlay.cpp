@@ -106,8 +106,7 @@ void run_live(OverlayOptions& o) {
   // A window unless the frames go to files only.
   const bool window = o.window || (o.out.empty() && o.frames_dir.empty());
   live.overlay = overlay_settings(o, window);
-  if (auto_quality(o.composite))
-    throw InputError("--quality auto: chooses on a recording's frames; live, give the knobs (--shading, ...)");
+  live.auto_quality = auto_quality(o.composite);  // on the camera's first frames
   live.overlay.window_title = "lumar overlay (live)";
   if (window) live.overlay.window_panel_width = ui::kPanelWidth;
   pipeline::LiveOverlay overlay(live);

@@ -38,7 +38,12 @@ void add_composite_options(CLI::App* cmd, CompositeOptions& o) {
                   "lighting.irradiance.max_lights, else 16; docs/irradiance.md)");
   cmd->add_option("--quality", o.quality,
                   "full: the knobs as given; auto: before the run, the cheapest knobs whose composite stays within "
-                  "--quality-budget of theirs, measured on a few of the recording's frames (docs/results.md)")
+                  "--quality-budget of theirs, measured on a few of the recording's frames (live: on the camera's "
+                  "first frames; docs/results.md)")
+      ->capture_default_str();
+  cmd->add_option("--quality-frames", o.quality_frames,
+                  "--quality auto: frames each trial composites and times (after one untimed); fewer choose sooner "
+                  "from less of the video")
       ->capture_default_str();
   cmd->add_option("--quality-budget", o.quality_budget,
                   "--quality auto: how far each region (object, edge, shadow) may be from full quality, percent")
@@ -104,8 +109,10 @@ std::optional<pipeline::QualityBudget> auto_quality(const CompositeOptions& o) {
   if (o.quality != "full" && o.quality != "auto") throw InputError("--quality " + o.quality + ": use full or auto");
   if (!(o.quality_budget > 0.0 && o.quality_budget <= 100.0))
     throw InputError(fmt::format("--quality-budget {}: use a percentage above 0, up to 100", o.quality_budget));
+  if (!(o.quality_frames >= 1 && o.quality_frames <= 60))
+    throw InputError(fmt::format("--quality-frames {}: use 1 to 60", o.quality_frames));
   if (o.quality == "full") return std::nullopt;
-  return pipeline::QualityBudget{.percent = o.quality_budget};
+  return pipeline::QualityBudget{.percent = o.quality_budget, .frames = o.quality_frames};
 }
 
 void add_live_input_options(CLI::App* cmd, pipeline::LiveInputOptions& o, const std::string& camera_help) {

@@ -38,11 +38,13 @@ struct CompositeOptions {
   double coverage_mesh_px = pipeline::OverlayQuality{}.coverage_mesh_px;
   std::string quality = "full";
   double quality_budget = pipeline::QualityBudget{}.percent;
+  int quality_frames = pipeline::QualityBudget{}.frames;
 };
 void add_composite_options(CLI::App* cmd, CompositeOptions& o);
 // Applies them to `settings`; InputError names an unknown feature.
 void apply_composite_options(const CompositeOptions& o, pipeline::OverlaySettings& settings);
-// --quality auto: the budget for a replay's choice (ReplayOverlaySettings::auto_quality);
+// --quality auto: the budget for the choice (ReplayOverlaySettings::auto_quality, live
+// LiveOverlayOptions::auto_quality);
 // nullopt for full. InputError for another word or a budget out of range.
 std::optional<pipeline::QualityBudget> auto_quality(const CompositeOptions& o);
 

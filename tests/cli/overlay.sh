@@ -155,8 +155,32 @@ PY
     --quality-budget 0 --frames-dir "$TMP/bad"
   expect_bad_input "--shadow-map" "$TMP/bad" -- "$LUMAR" overlay --recording "$REC" --shadow-map 4 --frames-dir "$TMP/bad"
   expect_bad_input "--coverage-mesh" "$TMP/bad" -- "$LUMAR" overlay --recording "$REC" --coverage-mesh 9 --frames-dir "$TMP/bad"
-  expect_bad_input "--quality auto" "$TMP/bad" -- "$LUMAR" overlay --source "images:$TMP/none" --quality auto \
-    --frames-dir "$TMP/bad"
+  expect_bad_input "--quality-frames" "$TMP/bad" -- "$LUMAR" overlay --recording "$REC" --quality auto \
+    --quality-frames 0 --frames-dir "$TMP/bad"
+}
+
+case_live_quality_auto() {
+  # Live, --quality auto chooses on the camera's first frames with a pose (3 of them, 0.2 s
+  # apart, with --quality-frames 2) and composites at its choice from then on; the stage
+  # times start after the frame it chose on. The recording played as a camera brings its
+  # own poses.
+  "$LUMAR" overlay --source "recording:$REC" --scene "$SRC/data/scenes/room/scene.json" --quality auto \
+    --quality-frames 2 --frames-dir "$TMP/live" --stats-json "$TMP/stats.json" >"$TMP/log" 2>&1 ||
+    { cat "$TMP/log"; fail "live overlay --quality auto failed"; }
+  [ "$(grep -c "quality auto: pixel, 8 lines.*(the reference)" "$TMP/log")" -eq 1 ] || { cat "$TMP/log"; fail "no reference trial"; }
+  sed -nE 's/^quality auto: (.*): [0-9.]+ ms\/frame against full quality.* on 3 frames$/\1/p' "$TMP/log" >"$TMP/chosen"
+  [ "$(grep -c . "$TMP/chosen")" -eq 1 ] || { cat "$TMP/log"; fail "no choice made on 3 frames"; }
+  local shown
+  shown=$(sed -nE 's/^overlay: ([0-9]+) frames shown.*/\1/p' "$TMP/log")
+  [ "$(ls "$TMP/live" | wc -l)" -eq "$shown" ] || fail "$(ls "$TMP/live" | wc -l) frames written, $shown shown"
+  python3 - "$TMP/stats.json" "$TMP/chosen" "$shown" <<'PY' || { cat "$TMP/log"; fail "bad stats file"; }
+import json, sys
+s = json.load(open(sys.argv[1]))
+chosen, shown = open(sys.argv[2]).read().strip(), int(sys.argv[3])
+assert s['quality'] == chosen, (s['quality'], chosen)
+assert 1 <= s['frames'] <= shown - 3, (s['frames'], shown)  # after the 3 frames it chose on
+assert 0 < s['startup_ms'] < 60000, s['startup_ms']  # the first frame, shown before the choice
+PY
 }
 
 case_window_without_display_fails_cleanly() {

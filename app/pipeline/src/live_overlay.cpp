@@ -72,6 +72,31 @@ LiveOverlay::LiveOverlay(const LiveOverlayOptions& o) {
           "poses are used as they are");
   }
   if (recorded) loop_->use_recorded_poses(recorded);
+  if (o.auto_quality) choose_quality(*o.auto_quality);
+}
+
+void LiveOverlay::choose_quality(const QualityBudget& budget) {
+  if (budget.frames < 1) throw InputError("quality auto: needs at least one timed frame");
+  probe_budget_ = budget;
+  probes_.clear();
+  spdlog::info("quality auto: choosing on the next {} frames with a pose, {:.1f} s apart", budget.frames + 1,
+               kProbeSpacingS);
+}
+
+std::pair<int, int> LiveOverlay::quality_probes() const {
+  return probe_budget_ ? std::pair{int(probes_.size()), probe_budget_->frames + 1} : std::pair{0, 0};
+}
+
+bool LiveOverlay::probe(const capture::Frame& frame, const std::optional<Pose>& pose) {
+  if (!probe_budget_ || !pose) return false;
+  if (!probes_.empty() && nanos_to_seconds(frame.time - probes_.back().frame.time) < kProbeSpacingS) return false;
+  probes_.push_back({{frame.image.clone(), frame.time, frame.index}, *pose});  // the source reuses its buffer
+  if (int(probes_.size()) < probe_budget_->frames + 1) return false;
+  const QualityBudget budget = *probe_budget_;
+  probe_budget_.reset();
+  quality_choice_ = pipeline::choose_quality(*overlay_, probes_, budget);
+  probes_.clear();
+  return true;
 }
 
 void LiveOverlay::run(const std::function<bool(const OverlayFrame&)>& sink) {
@@ -82,11 +107,15 @@ void LiveOverlay::run(const std::function<bool(const OverlayFrame&)>& sink) {
         const std::optional<Pose> pose =
             fused_ ? fused_->update(paired.frame, paired.T_world_camera) : paired.T_world_camera;
         times.pose += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+        // The frame a choice was made on waited for it: the stage times start after it.
+        const auto first_composite = overlay_->first_composite_time();
+        const bool chose = probe(paired.frame, pose);
         const OverlayFrame out = overlay_->composite(paired.frame, pose);
         t0 = std::chrono::steady_clock::now();
         const bool go_on = sink(out);
         times.output += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
         times.latency += nanos_to_seconds(monotonic_now() - paired.frame.time) * 1e3;  // capture to handed on
+        if (chose) overlay_->reset_times(first_composite);
         return go_on;
       },
       [&] {
@@ -96,6 +125,11 @@ void LiveOverlay::run(const std::function<bool(const OverlayFrame&)>& sink) {
         }
         return true;
       });
+  if (const auto [have, need] = quality_probes(); need > 0)
+    spdlog::warn(
+        "quality auto: the source ended with {} of the {} frames with a pose a choice needs; the quality "
+        "stayed as given",
+        have, need);
   const auto& s = loop_->stats();
   spdlog::info("overlay: {} frames shown, {} stale frames skipped, {} without a pose, {} extrapolated", s.frames,
                s.queue.stale_dropped, s.without_pose, s.extrapolated);

@@ -130,14 +130,17 @@ QualityChoice choose_quality(Overlay& overlay, const std::vector<ProbeFrame>& fr
   overlay.set_quality(choice.choice().quality);
   overlay.compositor().set_features(features);
   overlay.reset_times();
-  const QualityTrial& c = choice.choice();
-  spdlog::info(
-      "quality auto: {}: {:.1f} ms/frame against full quality's {:.1f} ({:.2f}x), within {:.2f} % of it (object "
-      "{:.2f} %, edge {:.2f} %, shadow {:.2f} %), from {} trials on {} frames",
-      c.quality.describe(), c.ms_per_frame, choice.full().ms_per_frame, c.ms_per_frame / choice.full().ms_per_frame,
-      budget.percent, c.difference.object_err, c.difference.edge_err, c.difference.shadow_err, choice.trials.size(),
-      frames.size());
+  spdlog::info("quality auto: {} on {} frames", choice.describe(), frames.size());
   return choice;
+}
+
+std::string QualityChoice::describe() const {
+  const QualityTrial& c = choice();
+  return fmt::format(
+      "{}: {:.1f} ms/frame against full quality's {:.1f} ({:.2f}x), within {:.2f} % of it (object {:.2f} %, edge "
+      "{:.2f} %, shadow {:.2f} %), from {} trials",
+      c.quality.describe(), c.ms_per_frame, full().ms_per_frame, c.ms_per_frame / full().ms_per_frame, budget.percent,
+      c.difference.object_err, c.difference.edge_err, c.difference.shadow_err, trials.size());
 }
 
 }  // namespace lumar::pipeline

@@ -49,11 +49,13 @@ ReplayOverlay::ReplayOverlay(const std::filesystem::path& recording, const Repla
   overlay_ = std::make_unique<Overlay>(std::move(scene), session.camera, session.radiometry,
                                        calib::calibrated_response(session.radiometry, recording), settings.overlay);
   set_pose_source(pose_source_);
-  if (settings.auto_quality) {
-    quality_choice_ =
-        choose_quality(*overlay_, probe_frames(settings.auto_quality->frames + 1), *settings.auto_quality);
-    set_pose_source(pose_source_);  // the fusion starts again with the run's first frame
-  }
+  if (settings.auto_quality) choose_quality(*settings.auto_quality);
+}
+
+const QualityChoice& ReplayOverlay::choose_quality(const QualityBudget& budget) {
+  quality_choice_ = pipeline::choose_quality(*overlay_, probe_frames(budget.frames + 1), budget);
+  set_pose_source(pose_source_);  // the fusion starts again with the run's first frame
+  return *quality_choice_;
 }
 
 std::vector<ProbeFrame> ReplayOverlay::probe_frames(int count) {

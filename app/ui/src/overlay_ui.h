@@ -23,6 +23,7 @@
 #include "lumar/calib/image_file.h"
 #include "lumar/lighting/shadows/shadow_occlusion.h"
 #include "lumar/pipeline/overlay.h"
+#include "lumar/pipeline/quality_choice.h"
 #include "lumar/scene/scene.h"
 #include "lumar/ui/debug_views.h"
 #include "lumar/ui/overlay_window.h"
@@ -63,6 +64,13 @@ struct FrameStats {
 constexpr std::array<const char*, 2> kMethods{"volume", "sh9"};
 constexpr double kNudgeM = 0.01, kTurnDeg = 5.0, kDragPx = 3.0;
 
+// How the window's source chooses the quality knobs within a budget (quality_choice.h): a
+// replay at once, on frames spread over the recording; a live camera on its next frames.
+struct QualityChooser {
+  std::function<void(const pipeline::QualityBudget&)> choose;
+  std::function<std::string()> status;  // the last choice, or how far the next one has come
+};
+
 struct KeyPress {
   int key = 0, mods = 0;
   bool repeat = false;
@@ -87,9 +95,20 @@ class OverlayUi {
   OverlayUi(const OverlayUi&) = delete;
   OverlayUi& operator=(const OverlayUi&) = delete;
 
-  // Starts a frame: ImGui's, then the mouse (placing against the last composite's pose)
-  // and the keys, which `source_keys` sees first (it returns true for those it used).
+  void set_quality_chooser(QualityChooser chooser) { chooser_ = std::move(chooser); }
+
+  // Starts a frame: a choice of quality asked for in the last one (which said so), ImGui's
+  // frame, then the mouse (placing against the last composite's pose) and the keys, which
+  // `source_keys` sees first (it returns true for those it used).
   void begin_frame(const std::function<bool(const KeyPress&)>& source_keys) {
+    if (choose_pending_) {
+      choose_pending_ = false;
+      attempt("quality auto", [&] {
+        chooser_.choose(pipeline::QualityBudget{.percent = budget_percent_});
+        if (chooser_.status) say(chooser_.status(), false);
+      });
+      dirty_ = true;
+    }
     ImGui_ImplOpenGL3_NewFrame();
     ImGui_ImplGlfw_NewFrame();
     ImGui::NewFrame();
@@ -111,6 +130,7 @@ class OverlayUi {
     image_ = out.composite;
     pose_ = out.T_world_camera;
     const pipeline::StageTimes& t = overlay_.times();
+    if (t.frames < before.frames) return;  // the times started again (a choice of quality)
     FrameStats s;
     s.shadows = float(t.shadows - before.shadows);
     s.objects = float(t.objects - before.objects);
@@ -294,6 +314,9 @@ class OverlayUi {
         case GLFW_KEY_H:
           shadows_ = !shadows_, dirty_ = true;
           break;
+        case GLFW_KEY_A:
+          choose_quality();
+          break;
         case GLFW_KEY_S:
           if (ctrl) save_scene();
           break;
@@ -308,6 +331,14 @@ class OverlayUi {
           break;
       }
     }
+  }
+
+  // Said in this frame, done at the next one's start: the choice holds the window a few
+  // seconds.
+  void choose_quality() {
+    if (!chooser_.choose) return;
+    choose_pending_ = true;
+    say(fmt::format("choosing the cheapest quality within {:.2f} % of the current one...", budget_percent_), false);
   }
 
   void turn_selected(double degrees) {
@@ -371,9 +402,12 @@ class OverlayUi {
     ImGui::SetNextWindowPos(ImVec2(float(image_.cols), 0));
     ImGui::SetNextWindowSize(ImVec2(float(kPanelWidth), io.DisplaySize.y));
     ImGui::Begin("lumar", nullptr, ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoResize | ImGuiWindowFlags_NoCollapse);
-    if (!message_.empty())
-      ImGui::TextColored(message_error_ ? ImVec4(1.0f, 0.45f, 0.4f, 1.0f) : ImVec4(0.6f, 0.9f, 0.6f, 1.0f), "%s",
-                         message_.c_str());
+    if (!message_.empty()) {  // wrapped: a choice of quality says a long line
+      ImGui::PushStyleColor(ImGuiCol_Text,
+                            message_error_ ? ImVec4(1.0f, 0.45f, 0.4f, 1.0f) : ImVec4(0.6f, 0.9f, 0.6f, 1.0f));
+      ImGui::TextWrapped("%s", message_.c_str());
+      ImGui::PopStyleColor();
+    }
     if (source_panel) source_panel();
     objects_panel();
     lighting_panel();
@@ -414,7 +448,8 @@ class OverlayUi {
     ImGui::Text("rests at (%.3f, %.3f, %.3f) m", p.x, p.y, p.z);
     ImGui::TextDisabled("click: place  drag: slide  wheel, Q/E: turn");
     ImGui::TextDisabled("arrows: nudge 1 cm (shift: 5)  tab: next");
-    ImGui::TextDisabled("h: shadows  ctrl+O: mesh  ctrl+S: save");
+    ImGui::TextDisabled("h: shadows  a: choose the quality");
+    ImGui::TextDisabled("ctrl+O: mesh  ctrl+S: save  F12: screenshot");
   }
 
   void lighting_panel() {
@@ -447,21 +482,46 @@ class OverlayUi {
                          100.0 * *clipped);
   }
 
-  // The knobs that trade speed for accuracy, the pose filter, and what to draw over the video.
+  // The knobs that trade speed for accuracy (pipeline::OverlayQuality, each applied as it
+  // is let go), the choice of them within a budget, following the room's light, and what to
+  // draw over the video.
   void quality_panel() {
     if (!ImGui::CollapsingHeader("Quality and debug views")) return;
-    Compositor& compositor = overlay_.compositor();
-    ShadowQuality q = compositor.shadow_quality();
-    ImGui::SliderInt("emitter patches", &q.emitter_patches, 4, 256);
-    const bool patches_done = ImGui::IsItemDeactivatedAfterEdit();
-    ImGui::SliderInt("lines per patch", &q.lines_per_patch, 1, 32);
-    if (patches_done || ImGui::IsItemDeactivatedAfterEdit())
-      attempt("shadow quality", [&] {
-        compositor.set_shadow_quality(q);
+    pipeline::OverlayQuality q = overlay_.quality();
+    bool changed = false;
+    int shading = int(q.shading);  // the order of ObjectShading
+    if (ImGui::Combo("shading", &shading, "per pixel\0per vertex\0"))
+      q.shading = ObjectShading(shading), changed = true;
+    const IrradianceVolume* volume = overlay_.compositor().irradiance_volume().get();
+    int lights = q.exact_lights.value_or(volume ? int(volume->lights.size()) : 0);
+    ImGui::SliderInt("exact lights", &lights, 0, kMaxExactLights);
+    if (ImGui::IsItemDeactivatedAfterEdit()) q.exact_lights = lights, changed = true;
+    int map_n = q.shadow_map.value_or(volume ? volume->shadow_n : 0);
+    if (ImGui::BeginCombo("shadow maps", fmt::format("{} px", map_n).c_str())) {
+      for (int n = kMinShadowMapResolution; n <= kMaxShadowMapResolution; n *= 2)
+        if (ImGui::Selectable(fmt::format("{} px", n).c_str(), n == map_n)) q.shadow_map = n, changed = true;
+      ImGui::EndCombo();
+    }
+    ImGui::SliderInt("lines per patch", &q.shadows.lines_per_patch, 1, ShadowQuality::kMaxLinesPerPatch);
+    changed |= ImGui::IsItemDeactivatedAfterEdit();
+    ImGui::SliderInt("emitter patches", &q.shadows.emitter_patches, 4, 256);
+    changed |= ImGui::IsItemDeactivatedAfterEdit();
+    float coverage = float(q.coverage_mesh_px);
+    ImGui::SliderFloat("coverage meshes", &coverage, 0.0f, 4.0f, coverage > 0 ? "%.2f px" : "exact");
+    if (ImGui::IsItemDeactivatedAfterEdit()) q.coverage_mesh_px = coverage, changed = true;
+    if (changed)
+      attempt("quality", [&] {
+        overlay_.set_quality(q);  // new exact lights or maps: the volume is built again, or read from the cache
         dirty_ = true;
       });
-    if (const LineShadows* lines = compositor.shadows())
+    if (const LineShadows* lines = overlay_.compositor().shadows())
       ImGui::Text("%zu radiosity lines, %u emitter patches", lines->lines().lines.size(), lines->lines().patch_count);
+    if (chooser_.choose) {
+      ImGui::SliderFloat("budget", &budget_percent_, 0.25f, 10.0f, "%.2f %%", ImGuiSliderFlags_Logarithmic);
+      if (ImGui::Button("Choose the cheapest within it (A)")) choose_quality();
+      if (chooser_.status) ImGui::TextWrapped("%s", chooser_.status().c_str());
+    }
+    ImGui::TextDisabled("%s", q.describe().c_str());
     bool adapt = overlay_.live_lighting() != nullptr;
     if (ImGui::Checkbox("follow the room's lighting (every 10 frames)", &adapt))
       overlay_.set_adapt_lighting_every(adapt ? 10 : 0), dirty_ = true;
@@ -540,6 +600,11 @@ class OverlayUi {
   bool shadows_ = true, object_shadows_ = true;
   gl::CompositeFeatures features_;
   DebugViews debug_;
+
+  // quality
+  QualityChooser chooser_;
+  float budget_percent_ = float(pipeline::QualityBudget{}.percent);
+  bool choose_pending_ = false;
 
   std::vector<KeyPress> keys_;
   std::deque<FrameStats> stats_;

@@ -30,6 +30,8 @@ class ReplayWindow {
     frame_count_ = std::int64_t(replay_.replay().reader().frames().size());
     fps_ = std::max(1.0, replay_.replay().reader().video().fps);
     if (!seek(0)) throw InputError("overlay: the recording's first frame cannot be read");
+    ui_.set_quality_chooser({[this](const pipeline::QualityBudget& budget) { replay_.choose_quality(budget); },
+                             [this] { return replay_.quality_choice() ? replay_.quality_choice()->describe() : ""; }});
   }
 
   void run() {
@@ -162,7 +164,14 @@ class ReplayWindow {
 class LiveWindow {
  public:
   LiveWindow(pipeline::LiveOverlay& live, const OverlayWindowSettings& settings)
-      : live_(live), ui_(live.overlay(), *live.overlay().window(), settings) {}
+      : live_(live), ui_(live.overlay(), *live.overlay().window(), settings) {
+    ui_.set_quality_chooser({[this](const pipeline::QualityBudget& budget) { live_.choose_quality(budget); },
+                             [this]() -> std::string {
+                               if (const auto [have, need] = live_.quality_probes(); need > 0)
+                                 return fmt::format("collecting frames to choose on: {} of {}", have, need);
+                               return live_.quality_choice() ? live_.quality_choice()->describe() : "";
+                             }});
+  }
 
   // One camera frame: the panels, the composite, the swap. False: the window was closed.
   bool frame(const pipeline::OverlayFrame& out, const pipeline::StageTimes& before) {

@@ -145,10 +145,11 @@ class Overlay {
   const LoadedScene& scene() const { return compositor_->scene(); }
   gl::WindowContext* window() { return window_; }
   StageTimes& times() { return times_; }  // composite() fills the rendering stages; callers the rest
-  // Clears the stage times and the first composite's time (after frames that were not the run's).
-  void reset_times() {
+  // Clears the stage times (after frames that were not the run's); the first composite's
+  // time becomes `first_composite` (a live run's first frame came before a choice of quality).
+  void reset_times(std::optional<std::chrono::steady_clock::time_point> first_composite = std::nullopt) {
     times_ = {};
-    first_composite_.reset();
+    first_composite_ = first_composite;
   }
   // When the first frame's composite was ready (steady clock); nullopt before it.
   std::optional<std::chrono::steady_clock::time_point> first_composite_time() const { return first_composite_; }

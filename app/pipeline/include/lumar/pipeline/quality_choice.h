@@ -15,6 +15,7 @@
 // kept when its three differences are within the budget and its frames are faster than the
 // best so far by kQualityMinGain; a knob's next level is not tried once one is outside the
 // budget.
+#include <string>
 #include <vector>
 
 #include "lumar/pipeline/composite_error.h"
@@ -47,6 +48,9 @@ struct QualityChoice {
   std::size_t chosen = 0;            // index into trials
   const QualityTrial& full() const { return trials.front(); }
   const QualityTrial& choice() const { return trials[chosen]; }
+  // "vertex, 4 lines, ...: 27.2 ms/frame against full quality's 78.0 (0.35x), within 1.50 %
+  // of it (object 0.32 %, edge 0.72 %, shadow 0.27 %), from 9 trials"
+  std::string describe() const;
 };
 
 struct ProbeFrame {

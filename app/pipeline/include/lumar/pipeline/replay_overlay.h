@@ -67,7 +67,12 @@ class ReplayOverlay {
   // `count` frames spread evenly over the recording (each the first at or after its place
   // that has a camera pose), for choose_quality.
   std::vector<ProbeFrame> probe_frames(int count);
-  // What ReplayOverlaySettings::auto_quality chose (nullopt: not asked for).
+  // Chooses the quality knobs on probe_frames(budget.frames + 1), from the overlay's
+  // current quality as full quality (quality_choice.h), and leaves the overlay at the
+  // choice; the fusion of poses starts again. What settings.auto_quality asks for before
+  // the run; the window's "Choose" asks for it again after edits.
+  const QualityChoice& choose_quality(const QualityBudget& budget);
+  // The last choice (nullopt: none asked for).
   const std::optional<QualityChoice>& quality_choice() const { return quality_choice_; }
 
   const capture::RecordingReplay& replay() const { return replay_; }
