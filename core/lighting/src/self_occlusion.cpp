@@ -11,6 +11,14 @@
 namespace lumar {
 
 std::vector<VertexOcclusion> bake_self_occlusion(const Mesh& model, const SelfOcclusionSettings& settings) {
+  RayScene scene;
+  if (model.triangle_count() > 0) scene.add_static(model);
+  scene.commit();
+  return bake_self_occlusion(model, scene, settings);
+}
+
+std::vector<VertexOcclusion> bake_self_occlusion(const Mesh& model, const RayScene& scene,
+                                                 const SelfOcclusionSettings& settings) {
   if (model.normals.size() != model.positions.size())
     throw InputError("bake_self_occlusion: the mesh needs one normal per vertex; load it with load_mesh");
   if (settings.strata < 1) throw InputError("bake_self_occlusion: strata must be at least 1");
@@ -18,9 +26,6 @@ std::vector<VertexOcclusion> bake_self_occlusion(const Mesh& model, const SelfOc
   std::vector<VertexOcclusion> out(n);
   for (std::size_t i = 0; i < n; ++i) out[i].bent_normal = model.normals[i];
   if (model.triangle_count() == 0) return out;
-  RayScene scene;
-  scene.add_static(model);
-  scene.commit();
   const auto [lo, hi] = model.bounds();
   const float offset = float(settings.offset * glm::length(glm::dvec3(hi) - glm::dvec3(lo)));
   const int s = settings.strata, count = s * s;

@@ -71,9 +71,10 @@ void Compositor::bake_self_occlusion_once() {
   if (!self_occlusion_.empty() || scene_->objects.empty()) return;
   const auto t0 = std::chrono::steady_clock::now();
   for (std::size_t i = 0; i < scene_->objects.size(); ++i) {
-    self_occlusion_.push_back(bake_self_occlusion(scene_->objects[i].model));
-    renderer_->set_object_self_occlusion(int(i), self_occlusion_.back());
+    // One ray scene of the mesh for both: the open share and the exact lights' shadow.
     light_self_shadow_.push_back(std::make_shared<const LightSelfShadow>(scene_->objects[i].model));
+    self_occlusion_.push_back(bake_self_occlusion(scene_->objects[i].model, light_self_shadow_.back()->scene()));
+    renderer_->set_object_self_occlusion(int(i), self_occlusion_.back());
   }
   spdlog::debug("self-occlusion baked in {:.0f} ms",
                 std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());

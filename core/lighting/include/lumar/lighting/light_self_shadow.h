@@ -33,6 +33,9 @@ class LightSelfShadow {
   std::vector<float> blocked(const glm::dmat4& T_world_model, std::span<const VolumeLight> lights,
                              const glm::dvec3& capture) const;
 
+  // The model's ray scene, in model space (for bake_self_occlusion).
+  const RayScene& scene() const { return *scene_; }
+
  private:
   Mesh model_;
   std::unique_ptr<RayScene> scene_;

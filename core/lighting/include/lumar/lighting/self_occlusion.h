@@ -22,8 +22,14 @@ struct SelfOcclusionSettings {
   double offset = 1e-4;
 };
 
+class RayScene;
+
 // One value per vertex (mesh order); the mesh needs one normal per vertex (InputError
 // otherwise). A mesh without triangles is open everywhere. Deterministic for a mesh.
 std::vector<VertexOcclusion> bake_self_occlusion(const Mesh& model, const SelfOcclusionSettings& settings = {});
+// The same against a ray scene already built of `model` alone, in model space (as
+// LightSelfShadow's), so that one mesh is not built into two.
+std::vector<VertexOcclusion> bake_self_occlusion(const Mesh& model, const RayScene& model_scene,
+                                                 const SelfOcclusionSettings& settings = {});
 
 }  // namespace lumar

@@ -132,7 +132,8 @@ class Renderer {
   // meshes as given. Throws InputError outside [0, kMaxCoverageErrorPx].
   void set_coverage_mesh_error(double pixels);
   double coverage_mesh_error() const;
-  // The objects' triangles the last antialiasing pass drew.
+  // The objects' triangles the last antialiasing pass drew (a frame without the pass, or
+  // without a pose, leaves it as it was).
   std::size_t coverage_triangles() const;
   static constexpr double kMaxCoverageErrorPx = 8.0;
 
