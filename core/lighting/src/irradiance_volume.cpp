@@ -11,6 +11,7 @@
 #include "lumar/base/error.h"
 #include "lumar/base/latlong.h"
 #include "lumar/base/octahedral.h"
+#include "lumar/base/sphere_directions.h"
 #include "lumar/lighting/sh.h"
 
 namespace lumar {
@@ -18,17 +19,6 @@ namespace lumar {
 namespace {
 
 constexpr double kDepthSharpness = 20.0;  // cosine power that spreads ray distances over moment texels
-
-std::vector<glm::dvec3> fibonacci_directions(int count) {
-  std::vector<glm::dvec3> out(std::size_t(std::max(count, 1)));
-  const double golden = kPi * (3.0 - std::sqrt(5.0));
-  for (int j = 0; j < int(out.size()); ++j) {
-    const double y = 1.0 - (2.0 * j + 1.0) / double(out.size());
-    const double r = std::sqrt(std::max(0.0, 1.0 - y * y));
-    out[std::size_t(j)] = {r * std::cos(golden * j), y, r * std::sin(golden * j)};
-  }
-  return out;
-}
 
 struct Contribution {
   glm::dvec3 direction;

@@ -13,6 +13,7 @@
 #include <numeric>
 
 #include "lumar/base/error.h"
+#include "lumar/base/sphere_directions.h"
 #include "lumar/lighting/ray_scene.h"
 
 namespace lumar {
@@ -24,14 +25,12 @@ using SurfaceMesh = CGAL::Surface_mesh<Kernel::Point_3>;
 using TriangleOracle = CGAL::Alpha_wraps_3::internal::Triangle_soup_oracle<Kernel>;
 using Oracle = CGAL::Alpha_wraps_3::internal::Point_set_oracle<Kernel, TriangleOracle>;
 
-// Evenly spread directions (a Fibonacci sphere): the inside test looks every way.
+// Evenly spread directions: the inside test looks every way. Their rings run along z
+// here, as when the shipped solids were made (any axis would do, but another gives other
+// near-ties at grid points, and other bytes).
 std::vector<glm::vec3> sphere_directions(int n) {
   std::vector<glm::vec3> out;
-  const double golden = M_PI * (3.0 - std::sqrt(5.0));
-  for (int i = 0; i < n; ++i) {
-    const double z = 1.0 - (i + 0.5) * 2.0 / n, r = std::sqrt(1.0 - z * z);
-    out.emplace_back(float(r * std::cos(golden * i)), float(r * std::sin(golden * i)), float(z));
-  }
+  for (const glm::dvec3& d : fibonacci_directions(n)) out.emplace_back(float(d.x), float(d.z), float(d.y));
   return out;
 }
 
