@@ -92,6 +92,9 @@ void register_synth(CLI::App& app) {
   cmd->add_option("--truth-seed", s->truth_seed,
                   "--truth: the noise seed of the second truth (truth/other-seed-*), the noise floor; 0 = --seed + 1")
       ->capture_default_str();
+  cmd->add_option("--truth-strata", s->truth_strata,
+                  "--truth: N*N rays per object pixel, N from 2 to 64; the truth's own noise falls as 1/N")
+      ->capture_default_str();
   // A change of the room's light during the recording.
   auto change_box = std::make_shared<std::vector<double>>();
   auto change_scale = std::make_shared<std::vector<double>>();

@@ -3,7 +3,7 @@
 // docs/ground_truth.md): each region's error against milliseconds per frame, through the
 // pipeline library `lumar regress` runs. Baseline: every feature off, in the same run
 // (the 2004 system's look: no antialiasing, no self-occlusion). Writes
-// docs/composite_error_vs_cost.png (object, edge and shadow side by side) and
+// docs/composite_error_vs_cost.png (object, edge and shadow, one above the other) and
 // docs/composite_before_after_truth.png (crops at the figurine's feet: every feature off,
 // every feature on, the truth) and docs/solid_scan_vs_closed.png (crops of the upper body:
 // the composite with the figurine's open scan, with its closed solid, the truth;
@@ -15,10 +15,11 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include <fstream>
 #include <nlohmann/json.hpp>
 
 #include "bench_report.h"
+#include "lumar/base/json_file.h"
+#include "lumar/base/output_file.h"
 #include "lumar/calib/camera_file.h"
 #include "lumar/calib/image_file.h"
 #include "lumar/pipeline/truth_comparison.h"
@@ -55,12 +56,12 @@ cv::Rect feet(const cv::Mat& truth_mask) {
 // written beside the recording (its paths made absolute).
 fs::path scene_with_the_scan(const fs::path& dir) {
   const fs::path room = kSource / "data/scenes/room";
-  nlohmann::json j = nlohmann::json::parse(std::ifstream(room / "scene.json"));
+  nlohmann::json j = read_json_file(room / "scene.json", "scene manifest");
   j["room"]["mesh"] = (room / j["room"]["mesh"].get<std::string>()).lexically_normal().string();
   j["environment_map"]["path"] = (room / j["environment_map"]["path"].get<std::string>()).lexically_normal().string();
   for (auto& o : j["objects"]) o["mesh"] = (kSource / "data/models/parasaurolophus_6700.ply").string();
   const fs::path path = dir / "scene_with_the_scan.json";
-  std::ofstream(path) << j.dump(2);
+  write_file_atomically(path, j.dump(2));
   return path;
 }
 
@@ -106,16 +107,11 @@ int main() {
     spdlog::info("{:<26} {:6.1f} ms/frame  object {:.2f} %  edge {:.2f} %  shadow {:.2f} %  noise ratio {:.2f}", name,
                  compared->ms_per_frame, e.object_err, e.edge_err, e.shadow_err, e.noise_ratio);
   }
-  std::vector<cv::Mat> charts;
   for (auto& r : reports) {
     r.note = "8 frames of the sample room's orbit with their truth; ms per frame (decode to read-back) on llvmpipe";
     r.compute_ratios();
-    r.save(bench::results_dir());
-    charts.push_back(cv::imread((bench::results_dir() / (r.name + ".png")).string(), cv::IMREAD_COLOR));
   }
-  cv::Mat tiled;
-  cv::hconcat(charts, tiled);
-  calib::write_image_atomically(kSource / "docs/composite_error_vs_cost.png", tiled);
+  bench::publish_stacked(reports, "composite_error_vs_cost.png");
 
   // The last frame's feet, 4 times enlarged: before, after, truth.
   const cv::Rect crop = feet(mask);

@@ -46,6 +46,23 @@ void text(cv::Mat& img, const std::string& s, cv::Point at, double scale = 0.45,
 
 std::string short_number(double v) { return fmt::format("{:.3g}", v); }
 
+// Round values between 10^l0 and 10^l1 for a log axis: 1, 2, 5 per decade, or finer
+// steps when the axis spans less than that gives three of.
+std::vector<double> log_ticks(double l0, double l1) {
+  for (const auto& mantissas :
+       {std::vector<double>{1, 2, 5}, std::vector<double>{1, 1.5, 2, 3, 4, 5, 6, 7, 8},
+        std::vector<double>{1, 1.1, 1.2, 1.3, 1.4, 1.5, 1.6, 1.8, 2, 2.2, 2.5, 3, 3.5, 4, 4.5, 5, 6, 7, 8, 9}}) {
+    std::vector<double> ticks;
+    for (double d = std::floor(l0); d <= std::ceil(l1); d += 1)
+      for (const double m : mantissas) {
+        const double v = m * std::pow(10, d), l = std::log10(v);
+        if (l >= l0 && l <= l1) ticks.push_back(v);
+      }
+    if (ticks.size() >= 3) return ticks;
+  }
+  return {std::pow(10, 0.5 * (l0 + l1))};
+}
+
 }  // namespace
 
 void BenchReport::write_chart(const std::filesystem::path& file) const {
@@ -55,7 +72,16 @@ void BenchReport::write_chart(const std::filesystem::path& file) const {
   int label_width = 240;
   for (const auto& e : entries)
     label_width = std::max(label_width, cv::getTextSize(e.name, cv::FONT_HERSHEY_SIMPLEX, 0.45, 1, nullptr).width);
-  const int W = 660 + label_width, H = tradeoff ? 560 : 120 + 34 * int(entries.size());
+  // The error-against-time plot is 600 pixels wide with its legend to the right of it.
+  const auto legend_line = [](const BenchEntry& e) {
+    return fmt::format("{}   {} ms   {}", e.name, short_number(e.time_ms), short_number(e.error));
+  };
+  int legend_width = 0;
+  for (const auto& e : entries)
+    legend_width =
+        std::max(legend_width, cv::getTextSize(legend_line(e), cv::FONT_HERSHEY_SIMPLEX, 0.4, 1, nullptr).width);
+  const int W = tradeoff && !xy ? 90 + 600 + 48 + legend_width + 20 : 660 + label_width;
+  const int H = tradeoff ? 560 : 120 + 34 * int(entries.size());
   cv::Mat img(H, W, CV_8UC3, cv::Scalar(255, 255, 255));
   text(img, title, {20, 30}, 0.6);
   if (xy) {
@@ -126,37 +152,82 @@ void BenchReport::write_chart(const std::filesystem::path& file) const {
     }
     text(img, fmt::format("ratios against '{}' measured in the same run", baseline), {20, H - 20}, 0.42);
   } else {
-    // Error against time, both on log axes; each point labelled.
-    const int left = 90, right = W - 40, top = 60, bottom = H - 70;
+    // Error against time, both on log axes. Points are numbered (each number placed where
+    // it overlaps no other) and a legend beside the plot names them with their values,
+    // since configurations of similar cost and error cluster and their names would not fit.
+    const int left = 90, right = left + 600, top = 60, bottom = H - 70;
     double t0 = 1e300, t1 = 0, e0 = 1e300, e1 = 0;
     for (const auto& e : entries) {
       if (std::isnan(e.error)) continue;
       t0 = std::min(t0, e.time_ms), t1 = std::max(t1, e.time_ms);
       e0 = std::min(e0, std::max(e.error, 1e-6)), e1 = std::max(e1, std::max(e.error, 1e-6));
     }
-    const double lt0 = std::floor(std::log10(t0)), lt1 = std::ceil(std::log10(t1)) + (t1 == t0 ? 1 : 0);
-    const double le0 = std::floor(std::log10(e0)), le1 = std::ceil(std::log10(e1)) + (e1 == e0 ? 1 : 0);
+    // Log axes around the points, not whole decades: configurations of one method often
+    // lie within a few tens of percent of each other and would huddle in one corner.
+    const double lt0 = std::log10(t0) - 0.08, lt1 = std::log10(t1) + 0.08;
+    const double le0 = std::log10(e0) - 0.1, le1 = std::log10(e1) + 0.1;
     auto px = [&](double t) { return left + int((right - left) * (std::log10(t) - lt0) / (lt1 - lt0)); };
     auto py = [&](double e) {
       return bottom - int((bottom - top) * (std::log10(std::max(e, 1e-6)) - le0) / (le1 - le0));
     };
-    for (double d = lt0; d <= lt1; d += 1) {
-      cv::line(img, {px(std::pow(10, d)), top}, {px(std::pow(10, d)), bottom}, kGrid);
-      text(img, short_number(std::pow(10, d)), {px(std::pow(10, d)) - 12, bottom + 20}, 0.4);
+    for (const double v : log_ticks(lt0, lt1)) {
+      cv::line(img, {px(v), top}, {px(v), bottom}, kGrid);
+      text(img, short_number(v), {px(v) - 8, bottom + 20}, 0.4);
     }
-    for (double d = le0; d <= le1; d += 1) {
-      cv::line(img, {left, py(std::pow(10, d))}, {right, py(std::pow(10, d))}, kGrid);
-      text(img, short_number(std::pow(10, d)), {10, py(std::pow(10, d)) + 5}, 0.4);
+    for (const double v : log_ticks(le0, le1)) {
+      cv::line(img, {left, py(v)}, {right, py(v)}, kGrid);
+      text(img, short_number(v), {10, py(v) + 5}, 0.4);
     }
     cv::rectangle(img, {left, top}, {right, bottom}, kInk);
     text(img, "time per operation (ms, log)", {(left + right) / 2 - 100, H - 25});
     text(img, error_label + " (log)", {left, top - 10}, 0.42);
+    // Dots first, so that numbers avoid every dot, not only the ones drawn before them.
+    std::vector<cv::Rect> taken;
+    const auto colour_of = [&](const BenchEntry& e) {
+      return e.name == highlight ? cv::Scalar(40, 160, 40) : e.name == baseline ? kBar : kDot;
+    };
     for (const auto& e : entries) {
       if (std::isnan(e.error)) continue;
       const cv::Point p(px(e.time_ms), py(e.error));
-      cv::circle(img, p, 5, e.name == baseline ? kBar : kDot, cv::FILLED, cv::LINE_AA);
-      text(img, e.name, p + cv::Point(8, -6), 0.4);
+      const int r = e.name == highlight ? 7 : 5;
+      cv::circle(img, p, r, colour_of(e), cv::FILLED, cv::LINE_AA);
+      taken.push_back(cv::Rect(p.x - r, p.y - r, 2 * r + 1, 2 * r + 1));
     }
+    const double legend_row = std::min(20.0, double(bottom - top) / std::max<std::size_t>(1, entries.size()));
+    for (std::size_t i = 0; i < entries.size(); ++i) {
+      const auto& e = entries[i];
+      const std::string number = std::to_string(i + 1);
+      const int y = top + 12 + int(legend_row * double(i));
+      text(img, number, {right + 20, y}, 0.4, colour_of(e));
+      text(img, legend_line(e), {right + 48, y}, 0.4);
+      if (std::isnan(e.error)) continue;
+      const cv::Point p(px(e.time_ms), py(e.error));
+      const cv::Size size = cv::getTextSize(number, cv::FONT_HERSHEY_SIMPLEX, 0.4, 1, nullptr);
+      // Candidate places around the dot (text origin is its lower left corner); the first
+      // free one, else the least covered.
+      const cv::Point offsets[] = {{8, -4},
+                                   {8, 12},
+                                   {-8 - size.width, -4},
+                                   {-8 - size.width, 12},
+                                   {-size.width / 2, -9},
+                                   {-size.width / 2, 9 + size.height},
+                                   {14, -14},
+                                   {14, 22},
+                                   {-14 - size.width, -14},
+                                   {-14 - size.width, 22}};
+      cv::Rect best;
+      int best_overlap = INT32_MAX;
+      for (const cv::Point& o : offsets) {
+        const cv::Rect box(p.x + o.x, p.y + o.y - size.height, size.width, size.height);
+        int overlap = 0;
+        for (const cv::Rect& t : taken) overlap += (box & t).area();
+        if (overlap < best_overlap) best_overlap = overlap, best = box;
+        if (overlap == 0) break;
+      }
+      taken.push_back(best);
+      text(img, number, {best.x, best.y + best.height}, 0.4, colour_of(e));
+    }
+    if (!note.empty()) text(img, note, {20, H - 5}, 0.4);
   }
   calib::write_image_atomically(file, img);
 }
@@ -170,6 +241,21 @@ void BenchReport::publish(std::size_t expected_entries) const {
   std::filesystem::copy_file(results_dir() / (name + ".png"),
                              std::filesystem::path(LUMAR_SOURCE_DIR) / "docs" / (name + ".png"),
                              std::filesystem::copy_options::overwrite_existing);
+}
+
+void publish_stacked(const std::vector<BenchReport>& reports, const std::string& docs_png) {
+  std::vector<cv::Mat> charts;
+  int width = 0;
+  for (const auto& r : reports) {
+    r.save(results_dir());
+    charts.push_back(cv::imread((results_dir() / (r.name + ".png")).string(), cv::IMREAD_COLOR));
+    width = std::max(width, charts.back().cols);
+  }
+  for (cv::Mat& c : charts)
+    cv::copyMakeBorder(c, c, 0, 0, 0, width - c.cols, cv::BORDER_CONSTANT, cv::Scalar(255, 255, 255));
+  cv::Mat stacked;
+  cv::vconcat(charts, stacked);
+  calib::write_image_atomically(std::filesystem::path(LUMAR_SOURCE_DIR) / "docs" / docs_png, stacked);
 }
 
 void BenchReport::save(const std::filesystem::path& dir) const {

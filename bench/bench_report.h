@@ -45,6 +45,10 @@ struct BenchReport {
   void publish(std::size_t expected_entries) const;
 };
 
+// Charts of the same runs (e.g. one per image region) that the docs show together: saves
+// each into results_dir() and writes them one above the other to docs/<docs_png>.
+void publish_stacked(const std::vector<BenchReport>& reports, const std::string& docs_png);
+
 // Where results go: $LUMAR_BENCH_OUT, else bench/results in the source tree.
 std::filesystem::path results_dir();
 

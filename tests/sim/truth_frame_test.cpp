@@ -31,15 +31,27 @@ namespace {
 
 constexpr double kRadius = 0.5, kHeight = 4.0;
 
+// A closed room of uniform radiance, or (`distant`) a uniform distant sky over a ground
+// plane: the sphere's light and the floor's ratio are the same on paper.
 struct UniformRoomWithSphere {
   EnvironmentMap map;
   std::unique_ptr<RoomRadiance> room;
+  RayScene ground;  // the distant sky's: the surface its map is shown on
+  const RayScene* surfaces = nullptr;
   std::vector<LoadedObject> objects;
-  UniformRoomWithSphere() {
+  explicit UniformRoomWithSphere(bool distant = false) {
     map.width = 128, map.height = 64;
     map.rgb.assign(std::size_t(map.width) * map.height * 3, 1.0f);
     map.capture_position = {0.0, 2.5, 0.0};
-    room = std::make_unique<RoomRadiance>(map, make_box({-3, 0, -3}, {3, 5, 3}, true), RadianceSettings{});
+    if (distant) {
+      room = std::make_unique<RoomRadiance>(map, RadianceSettings{});
+      ground.add_static(make_quad({0, 0, 0}, {50, 0, 0}, {0, 0, 50}, {0, 1, 0}));
+      ground.commit();
+      surfaces = &ground;
+    } else {
+      room = std::make_unique<RoomRadiance>(map, make_box({-3, 0, -3}, {3, 5, 3}, true), RadianceSettings{});
+      surfaces = room->ray_scene();
+    }
     LoadedObject sphere;
     sphere.model = make_sphere(glm::vec3(0.0f), float(kRadius), 96, 48);
     sphere.T_world_model = glm::translate(glm::dmat4(1.0), glm::dvec3(0, kRadius, 0));
@@ -64,8 +76,8 @@ Pose looking_down_pose() {
   return p;
 }
 
-void check_against_paper(int ratio_stride) {
-  UniformRoomWithSphere scene;
+void check_against_paper(int ratio_stride, bool distant = false) {
+  UniformRoomWithSphere scene(distant);
   CompositeReferenceSettings rs;
   rs.cone_strata = 16;
   const CompositeReference reference(*scene.room, scene.objects, rs);
@@ -74,7 +86,7 @@ void check_against_paper(int ratio_stride) {
   sim::TruthSettings ts;
   ts.ratio_stride = ratio_stride;
   const cv::Mat empty(camera.height, camera.width, CV_32FC3, cv::Scalar::all(1.0));
-  const sim::TruthFrame truth = sim::render_truth_frame(reference, camera, pose, empty, ts);
+  const sim::TruthFrame truth = sim::render_truth_frame(reference, *scene.surfaces, camera, pose, empty, ts);
 
   // The outline: the sphere's centre is D = kHeight − R below the camera, on its axis.
   const double D = kHeight - kRadius;
@@ -97,8 +109,9 @@ void check_against_paper(int ratio_stride) {
       const double expected = 1.0 - 0.5 * std::pow(kRadius / d, 3);
       worst_floor = std::max(worst_floor, std::abs(L[1] - expected));
     }
-  std::printf("stride %d: %.0f pixels covered (paper %.0f); worst error on the sphere %.4f, on the floor %.4f\n",
-              ratio_stride, covered, kPi * outline * outline, worst_object, worst_floor);
+  std::printf("%s, stride %d: %.0f pixels covered (paper %.0f); worst error on the sphere %.4f, on the floor %.4f\n",
+              distant ? "distant sky over a ground plane" : "closed room", ratio_stride, covered,
+              kPi * outline * outline, worst_object, worst_floor);
   EXPECT_LT(worst_object, 0.02);
   EXPECT_LT(worst_floor, 0.03);
 }
@@ -106,6 +119,10 @@ void check_against_paper(int ratio_stride) {
 TEST(TruthFrame, SphereInAUniformRoomMatchesPaperAtEveryPixel) { check_against_paper(1); }
 
 TEST(TruthFrame, InterpolatedRatioStaysCloseToPaper) { check_against_paper(3); }
+
+// Under a distant map the objects' shadows fall on the room's mesh the map is shown on,
+// which the map's RoomRadiance does not hold (the courtyard's truth once had no shadows).
+TEST(TruthFrame, UnderADistantSkyTheShadowFallsOnTheGround) { check_against_paper(1, true); }
 
 TEST(TruthFrame, FarFromTheObjectTheEmptyRoomIsKeptExactly) {
   // Out of every object's reach the room's pixels are the empty room's, bit for bit.
@@ -116,7 +133,7 @@ TEST(TruthFrame, FarFromTheObjectTheEmptyRoomIsKeptExactly) {
   const CameraIntrinsics camera = looking_down_camera();
   cv::Mat empty(camera.height, camera.width, CV_32FC3);
   cv::randu(empty, 0.2, 3.0);
-  const sim::TruthFrame truth = sim::render_truth_frame(reference, camera, looking_down_pose(), empty);
+  const sim::TruthFrame truth = sim::render_truth_frame(reference, *scene.surfaces, camera, looking_down_pose(), empty);
   const cv::Rect corner(0, 0, 20, 20);
   EXPECT_EQ(cv::norm(truth.radiance(corner), empty(corner), cv::NORM_INF), 0.0);
   EXPECT_GT(cv::norm(truth.radiance, empty, cv::NORM_INF), 0.1);  // the sphere and its shadow
@@ -155,9 +172,10 @@ TEST(TruthFrame, PerPixelObjectsConvergeAndVertexShadingIsCoarser) {
   const cv::Mat empty = cv::Mat::zeros(camera.height, camera.width, CV_32FC3);
   sim::TruthSettings per_vertex;
   per_vertex.per_pixel_objects = false;
-  const sim::TruthFrame fine = sim::render_truth_frame(fine_reference, camera, pose, empty);
-  const sim::TruthFrame pixel = sim::render_truth_frame(reference, camera, pose, empty);
-  const sim::TruthFrame vertex = sim::render_truth_frame(reference, camera, pose, empty, per_vertex);
+  const sim::TruthFrame fine = sim::render_truth_frame(fine_reference, *room->ray_scene(), camera, pose, empty);
+  const sim::TruthFrame pixel = sim::render_truth_frame(reference, *room->ray_scene(), camera, pose, empty);
+  const sim::TruthFrame vertex =
+      sim::render_truth_frame(reference, *room->ray_scene(), camera, pose, empty, per_vertex);
   int pixels = 0;
   const double noise = mean_relative_difference(pixel, fine, &pixels), coarse = mean_relative_difference(vertex, fine);
   std::printf("%d figurine pixels against 32^2 rays per pixel: 16^2 per pixel %.2f %%, per vertex %.2f %%\n", pixels,

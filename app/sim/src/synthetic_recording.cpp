@@ -233,6 +233,8 @@ std::vector<SynthSettings> sample_room_light_changes(const std::filesystem::path
 void synthesize_recording(const SynthSettings& s) {
   if (s.frames < 2) throw InputError("--frames: need at least 2 frames");
   if (s.fps <= 0) throw InputError("--fps: must be positive");
+  if (s.truth_strata < 2 || s.truth_strata > 64)
+    throw InputError(fmt::format("--truth-strata {}: use 2 to 64 (N*N rays per object pixel)", s.truth_strata));
   if (std::filesystem::exists(s.out))
     throw InputError(s.out.string() + ": already exists; choose a new recording directory");
   const LoadedScene scene = load_scene_files(s.scene);
@@ -312,12 +314,24 @@ void synthesize_recording(const SynthSettings& s) {
   // a map of 128 rows (its bright texels summed exactly, the rest by rays).
   std::unique_ptr<RoomRadiance> truth_room;
   std::unique_ptr<CompositeReference> truth;
+  // Where the objects' shadows fall: the surfaces the video shows. A distant map's
+  // radiance has no proxy, but the video shows it on the room's mesh (a ground plane).
+  CompositeReferenceSettings truth_reference;
+  truth_reference.object_strata = s.truth_strata;
+  RayScene distant_map_ground;
+  const RayScene* room_surfaces = nullptr;
   if (s.truth) {
     if (scene.objects.empty()) throw InputError(s.scene.string() + ": --truth needs objects in the scene");
     RadianceSettings radiance = reference_radiance_settings();
     radiance.map_height = 128;
     truth_room = scene_radiance(seen_scene, radiance);
-    truth = std::make_unique<CompositeReference>(*truth_room, seen_scene.objects);
+    truth = std::make_unique<CompositeReference>(*truth_room, seen_scene.objects, truth_reference);
+    room_surfaces = truth_room->ray_scene();
+    if (!room_surfaces) {
+      distant_map_ground.add_static(seen_scene.room);
+      distant_map_ground.commit();
+      room_surfaces = &distant_map_ground;
+    }
   }
   const bool animated =
       std::any_of(scene.objects.begin(), scene.objects.end(), [](const LoadedObject& o) { return !o.path.empty(); });
@@ -355,9 +369,10 @@ void synthesize_recording(const SynthSettings& s) {
           if (animated) {  // the objects where their paths are at this frame
             std::vector<LoadedObject> posed = scene.objects;
             for (LoadedObject& o : posed) o.T_world_model = o.pose_at(nanos_to_seconds(t));
-            truth = std::make_unique<CompositeReference>(*truth_room, posed);
+            truth = std::make_unique<CompositeReference>(*truth_room, posed, truth_reference);
           }
-          const TruthFrame frame = render_truth_frame(*truth, pinhole, T_world_camera, radiance, truth_settings);
+          const TruthFrame frame =
+              render_truth_frame(*truth, *room_surfaces, pinhole, T_world_camera, radiance, truth_settings);
           const cv::Mat seen = calib::distort_image(frame.radiance, pinhole, s.camera);
           const std::filesystem::path dir = s.out / "truth";
           if (k == 0) std::filesystem::create_directories(dir);

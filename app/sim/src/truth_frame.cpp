@@ -19,27 +19,25 @@ PixelRay pixel_ray(const CameraIntrinsics& camera, const Pose& T_world_camera, d
   return {T_world_camera.translation, glm::normalize(T_world_camera.rotation * d)};
 }
 
-// Where a pixel's ray meets the proxy, with the proxy's normal facing the camera.
+// Where a pixel's ray meets the room's surfaces, with the hit's normal.
 struct RoomPoint {
   glm::dvec3 point, normal;
   double t;
 };
 
-std::optional<RoomPoint> room_point(const CompositeReference& reference, const PixelRay& ray) {
-  const RayScene* scene = reference.room().ray_scene();
-  if (!scene) return std::nullopt;  // a distant map: no proxy to shade
+std::optional<RoomPoint> room_point(const RayScene& room_surfaces, const PixelRay& ray) {
   Ray r;
   r.origin = glm::vec3(ray.origin);
   r.direction = glm::vec3(ray.direction);
-  const auto hit = scene->intersect(r);
+  const auto hit = room_surfaces.intersect(r);
   if (!hit) return std::nullopt;
   return RoomPoint{ray.origin + ray.direction * double(hit->t), glm::dvec3(hit->normal), double(hit->t)};
 }
 
 }  // namespace
 
-TruthFrame render_truth_frame(const CompositeReference& reference, const CameraIntrinsics& camera,
-                              const Pose& T_world_camera, const cv::Mat& empty_radiance,
+TruthFrame render_truth_frame(const CompositeReference& reference, const RayScene& room_surfaces,
+                              const CameraIntrinsics& camera, const Pose& T_world_camera, const cv::Mat& empty_radiance,
                               const TruthSettings& settings) {
   CV_Assert(empty_radiance.type() == CV_32FC3 && empty_radiance.cols == camera.width &&
             empty_radiance.rows == camera.height);
@@ -50,7 +48,7 @@ TruthFrame render_truth_frame(const CompositeReference& reference, const CameraI
   std::vector<glm::vec3> grid(std::size_t(gw) * gh, glm::vec3(1.0f));
   tbb::parallel_for(0, gh, [&](int j) {
     for (int i = 0; i < gw; ++i) {
-      const auto room = room_point(reference, pixel_ray(camera, T_world_camera, double(i * s), double(j * s)));
+      const auto room = room_point(room_surfaces, pixel_ray(camera, T_world_camera, double(i * s), double(j * s)));
       if (room) grid[std::size_t(j) * gw + i] = glm::vec3(reference.room_ratio(room->point, room->normal));
     }
   });
@@ -62,7 +60,7 @@ TruthFrame render_truth_frame(const CompositeReference& reference, const CameraI
     auto* covered = out.coverage.ptr<float>(r);
     for (int c = 0; c < W; ++c) {
       const PixelRay ray = pixel_ray(camera, T_world_camera, c, r);
-      const auto room = room_point(reference, ray);
+      const auto room = room_point(room_surfaces, ray);
       const auto object =
           reference.hit_object(ray.origin, ray.direction, room ? room->t : std::numeric_limits<double>::infinity());
       if (object) {

@@ -45,6 +45,9 @@ struct SynthSettings {
   bool truth = false;
   std::uint64_t truth_seed = 0;  // the other seed; 0: seed + 1
   int truth_ratio_stride = 4;    // TruthSettings::ratio_stride, in rendered (supersampled) pixels
+  // Rays per object pixel of the truth: strata² (CompositeReferenceSettings::object_strata).
+  // Their noise is the truth's own, which no seed changes; more rays, less of it.
+  int truth_strata = 16;
   // The room's light changes during the recording (light_change.h); not with truth.
   std::optional<LightChange> light_change;
   // The video shows a room that differs from the scene's proxy (furnished_room.h), which

@@ -8,6 +8,7 @@
 #include "lumar/base/camera.h"
 #include "lumar/base/pose.h"
 #include "lumar/lighting/composite_reference.h"
+#include "lumar/lighting/ray_scene.h"
 
 namespace lumar::sim {
 
@@ -27,9 +28,12 @@ struct TruthFrame {
 
 // `empty_radiance`: the room without objects as `camera` (a pinhole) sees it from
 // T_world_camera (CV_32FC3 BGR). Pixel (c, r) looks along the ray through (c, r) in
-// OpenCV's convention (docs/conventions.md).
-TruthFrame render_truth_frame(const CompositeReference& reference, const CameraIntrinsics& camera,
-                              const Pose& T_world_camera, const cv::Mat& empty_radiance,
+// OpenCV's convention (docs/conventions.md). `room_surfaces`: the room the empty image
+// shows, where the objects' shadows fall: the proxy (RoomRadiance::ray_scene()), or the
+// room's mesh under a distant map (the ground it is shown on), which that map's
+// RoomRadiance does not hold.
+TruthFrame render_truth_frame(const CompositeReference& reference, const RayScene& room_surfaces,
+                              const CameraIntrinsics& camera, const Pose& T_world_camera, const cv::Mat& empty_radiance,
                               const TruthSettings& settings = {});
 
 }  // namespace lumar::sim
