@@ -19,9 +19,11 @@ std::map<CLI::App*, std::function<void()>>& actions() {
 void add_action(CLI::App* sub, std::function<void()> run) { actions()[sub] = std::move(run); }
 
 void add_composite_options(CLI::App* cmd, CompositeOptions& o) {
-  cmd->add_option("--without", o.without,
-                  "Switch off what makes the objects look like the camera's pixels: a comma-separated list of "
-                  "antialiasing, self-occlusion, noise, blur, bounce, or all (docs/ground_truth.md)");
+  cmd->add_option(
+      "--without", o.without,
+      "Switch off what makes the objects look like the camera's pixels: a comma-separated list of "
+      "antialiasing, self-occlusion, noise, blur, bounce, lines (the shadows' radiosity lines; without them, "
+      "the 2004 system's bounding-sphere shadows), or all (docs/ground_truth.md)");
   cmd->add_option("--blur-sigma", o.blur_sigma_px,
                   "The camera's blur as a Gaussian of this many output pixels (default: estimated from the video)")
       ->check(CLI::Range(0.0, 4.0));
@@ -73,11 +75,13 @@ void apply_composite_options(const CompositeOptions& o, pipeline::OverlaySetting
       f.blur = false;
     else if (name == "bounce")
       f.bounce = false;
+    else if (name == "lines")
+      f.lines = false;
     else if (name == "all")
-      f = gl::CompositeFeatures{false, false, false, false, false};
+      f = gl::CompositeFeatures{false, false, false, false, false, false};
     else
       throw InputError("--without " + without + ": unknown feature '" + name +
-                       "'; use antialiasing, self-occlusion, noise, blur, bounce or all");
+                       "'; use antialiasing, self-occlusion, noise, blur, bounce, lines or all");
   }
   if (o.blur_sigma_px >= 0) settings.blur_sigma_px = o.blur_sigma_px;
   if (o.shading != "pixel" && o.shading != "vertex")

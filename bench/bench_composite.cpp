@@ -1,10 +1,11 @@
 // The composite against its ground truth for every combination of the features that make
 // rendered pixels look like the camera's (antialiasing, self-occlusion, noise, blur:
 // docs/ground_truth.md): each region's error against milliseconds per frame, through the
-// pipeline library `lumar regress` runs. Baseline: every feature off, in the same run
-// (the 2004 system's look: no antialiasing, no self-occlusion). Writes
+// pipeline library `lumar regress` runs, the bounce and the shadow lines on. Baseline, in
+// the same run: the 2004 system's look (no antialiasing, no self-occlusion, no noise or
+// blur, no bounce, bounding-sphere shadows: `--without all`). Writes
 // docs/composite_error_vs_cost.png (object, edge and shadow, one above the other) and
-// docs/composite_before_after_truth.png (crops at the figurine's feet: every feature off,
+// docs/composite_before_after_truth.png (crops at the figurine's feet: the 2004 look,
 // every feature on, the truth) and docs/solid_scan_vs_closed.png (crops of the upper body:
 // the composite with the figurine's open scan, with its closed solid, the truth;
 // docs/solid.md).
@@ -31,6 +32,7 @@ namespace fs = std::filesystem;
 namespace {
 
 const fs::path kSource = LUMAR_SOURCE_DIR;
+const std::string k2004 = "2004: all off, no bounce, sphere shadows";
 
 std::string name_of(const gl::CompositeFeatures& f) {
   std::string name;
@@ -41,7 +43,7 @@ std::string name_of(const gl::CompositeFeatures& f) {
   add(f.self_occlusion, "occlusion");
   add(f.noise, "noise");
   add(f.blur, "blur");
-  return name.empty() ? "all off" : name;
+  return name.empty() ? "none of the four" : name;
 }
 
 // The figurine's feet and the floor around them: the bottom 40 % of the mask's box, widened.
@@ -85,19 +87,24 @@ int main() {
   for (int k = 0; k < 3; ++k) {
     reports[std::size_t(k)].name = std::string("composite_error_") + regions[k];
     reports[std::size_t(k)].title = std::string("Composite vs truth: ") + regions[k] + " region";
-    reports[std::size_t(k)].baseline = "all off";
+    reports[std::size_t(k)].baseline = k2004;
     reports[std::size_t(k)].error_label = std::string(regions[k]) + " error (% of the truth)";
     reports[std::size_t(k)].highlight = "aa+occlusion+noise+blur";
   }
   cv::Mat before, after, truth, mask;
-  for (int bits = 0; bits < 16; ++bits) {
+  // bits 0-15: the four features' combinations (bounce and the shadow lines on); -1: the
+  // 2004 system (every feature off, bounce off, the bounding-sphere shadows).
+  for (int bits = -1; bits < 16; ++bits) {
     pipeline::ReplayOverlaySettings settings;
-    settings.overlay.features = {bool(bits & 1), bool(bits & 2), bool(bits & 4), bool(bits & 8)};
-    const std::string name = name_of(settings.overlay.features);
+    if (bits < 0)
+      settings.overlay.features = gl::CompositeFeatures{false, false, false, false, false, false};
+    else
+      settings.overlay.features = {bool(bits & 1), bool(bits & 2), bool(bits & 4), bool(bits & 8)};
+    const std::string name = bits < 0 ? k2004 : name_of(settings.overlay.features);
     const auto compared = pipeline::compare_with_truth(
         out, settings, [&](const pipeline::OverlayFrame& f, const cv::Mat& truth_frame, const cv::Mat& truth_mask) {
-          if (f.index != synth.frames - 1 || (bits != 0 && bits != 15)) return;
-          (bits == 0 ? before : after) = f.composite.clone();
+          if (f.index != synth.frames - 1 || (bits != -1 && bits != 15)) return;
+          (bits < 0 ? before : after) = f.composite.clone();
           truth = truth_frame;
           mask = truth_mask;
         });

@@ -108,23 +108,33 @@ case_bounce_lowers_the_shadow_error() {
   # A saturated red box beside the figurine (data/scenes/room/red_box.json): the truth
   # carries the light it reflects onto the floor, so the composite's shadow region is
   # closer to it with bounce than without, in the same run of the same recording; and
-  # `--without all` (the 2004 look) switches bounce off too.
+  # `--without all` (the 2004 look) switches bounce off too, its shadows the bounding
+  # spheres' (`--without lines`).
   "$LUMAR" synth --scene "$SRC/data/scenes/room/red_box.json" --camera "$CAM" --out "$TMP/rec" --frames 2 \
     --supersample 1 --truth >"$TMP/log" 2>&1 || { cat "$TMP/log"; fail "synth --truth failed"; }
   "$LUMAR" regress --update "$TMP/rec" >"$TMP/log" 2>&1 || { cat "$TMP/log"; fail "regress --update failed"; }
   "$LUMAR" regress --json "$TMP/rec" >"$TMP/with.json" 2>"$TMP/err" || { cat "$TMP/err"; fail "regress failed"; }
   "$LUMAR" regress --json --without bounce "$TMP/rec" >"$TMP/without.json" 2>"$TMP/err" ||
     { cat "$TMP/err"; fail "regress --without bounce failed"; }
-  python3 - "$TMP/with.json" "$TMP/without.json" <<'PY' || fail "bounce does not bring the shadow region closer to the truth"
+  # The golden frames were made with the lines: the spheres' composite fails them (exit
+  # 1), as it should, and still reports its errors.
+  "$LUMAR" regress --json --without lines,bounce "$TMP/rec" >"$TMP/spheres.json" 2>"$TMP/err"
+  [ $? -eq 1 ] && grep -q '"pass":false' "$TMP/spheres.json" ||
+    { cat "$TMP/err"; fail "regress --without lines,bounce did not measure and fail its golden frames"; }
+  python3 - "$TMP/with.json" "$TMP/without.json" "$TMP/spheres.json" <<'PY' ||
 import json, sys
-a, b = (json.load(open(f)) for f in sys.argv[1:3])
+a, b, c = (json.load(open(f)) for f in sys.argv[1:4])
 print("ok: shadow_err %.3f %% with bounce, %.3f %% without, noise floor %.3f %%; --without all %.3f %%"
       % (a["shadow_err"], b["shadow_err"], a["noise_floor_shadow_err"], a["all_off_shadow_err"]))
 assert a["shadow_err"] < b["shadow_err"] - 0.05, (a["shadow_err"], b["shadow_err"])
-# All off has no bounce: its shadow error is the one without bounce (and the other
-# features barely touch the room's pixels).
-assert abs(a["all_off_shadow_err"] - b["shadow_err"]) < 0.1, (a["all_off_shadow_err"], b["shadow_err"])
+# All off has no bounce and the 2004 shadows: its shadow error is the one of the bounding
+# spheres without bounce (the other features barely touch the room's pixels), far above
+# the lines'.
+print("the bounding spheres without bounce: shadow_err %.3f %%" % c["shadow_err"])
+assert abs(a["all_off_shadow_err"] - c["shadow_err"]) < 0.1, (a["all_off_shadow_err"], c["shadow_err"])
+assert c["shadow_err"] > 2 * b["shadow_err"], (c["shadow_err"], b["shadow_err"])
 PY
+    fail "bounce does not bring the shadow region closer to the truth, or all off is not the 2004 look"
 }
 
 case_synth_refuses_existing_output() {

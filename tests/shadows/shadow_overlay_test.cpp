@@ -17,6 +17,7 @@
 #include "lumar/lighting/ray_scene.h"
 #include "lumar/lighting/shadows/object_bounce.h"
 #include "lumar/lighting/shadows/object_shadows.h"
+#include "lumar/lighting/shadows/shadow_methods.h"
 #include "lumar/lighting/shadows/shadow_occlusion.h"
 #include "lumar/render/compositor.h"
 #include "lumar/render/platform/context.h"
@@ -105,6 +106,21 @@ FloorChanges floor_changes(const cv::Mat& on, const cv::Mat& off, int c, int dir
   return out;
 }
 
+// The pixel where a receiver point is seen, if it is in view, off the objects (and their
+// outline rows), on a floor bright enough for its ratio to be measured in `off`.
+std::optional<cv::Point> receiver_pixel(const glm::vec3& point, const CameraIntrinsics& camera, const Pose& pose,
+                                        const cv::Mat& object_mask, const cv::Mat& linear_off) {
+  const glm::dvec3 pc = glm::dvec3(pose.inverse().matrix() * glm::dvec4(glm::dvec3(point), 1.0));
+  if (pc.z <= 0.1) return std::nullopt;
+  const glm::dvec2 uv = project_pinhole(camera, pc);
+  const int u = int(std::lround(uv.x)), v = int(std::lround(uv.y));
+  if (u < 1 || v < 1 || u >= camera.width - 1 || v >= camera.height - 1) return std::nullopt;
+  if (object_mask.at<uchar>(v, u) || object_mask.at<uchar>(v - 1, u) || object_mask.at<uchar>(v + 1, u))
+    return std::nullopt;
+  if (linear_off.at<cv::Vec3f>(v, u)[1] < 0.02f) return std::nullopt;
+  return cv::Point(u, v);
+}
+
 // The sample scene seen from frame 15 of the sample recording, with a current context.
 struct SampleView {
   CameraIntrinsics camera;
@@ -147,22 +163,15 @@ TEST(ShadowOverlay, VideoDarkensWhereTheLinesSayAndNowhereElse) {
   // Where the CPU predicts a shadow, the pixel at the vertex darkens by that ratio.
   const auto& origins = shadows.lines().origins;
   const auto& att = shadows.attenuation();
-  const glm::dmat4 T_camera_world = pose.inverse().matrix();
   int checked = 0;
   double worst = 0;
   for (std::size_t i = 0; i < origins.size(); ++i) {
     if (att[i].g > 0.9f) continue;
-    const glm::dvec3 pc = glm::dvec3(T_camera_world * glm::dvec4(glm::dvec3(origins[i]), 1.0));
-    if (pc.z <= 0.1) continue;
-    const glm::dvec2 uv = project_pinhole(camera, pc);
-    const int u = int(std::lround(uv.x)), v = int(std::lround(uv.y));
-    if (u < 1 || v < 1 || u >= camera.width - 1 || v >= camera.height - 1) continue;
-    if (object_mask.at<uchar>(v, u) || object_mask.at<uchar>(v - 1, u) || object_mask.at<uchar>(v + 1, u)) continue;
-    const float base = lin_off.at<cv::Vec3f>(v, u)[1];
-    if (base < 0.02f) continue;
-    const double ratio = lin_on.at<cv::Vec3f>(v, u)[1] / base;
+    const auto at = receiver_pixel(origins[i], camera, pose, object_mask, lin_off);
+    if (!at) continue;
+    const double ratio = lin_on.at<cv::Vec3f>(*at)[1] / lin_off.at<cv::Vec3f>(*at)[1];
     worst = std::max(worst, std::abs(ratio - att[i].g));
-    EXPECT_NEAR(ratio, att[i].g, 0.06) << "vertex " << i << " at pixel " << u << "," << v;
+    EXPECT_NEAR(ratio, att[i].g, 0.06) << "vertex " << i << " at pixel " << at->x << "," << at->y;
     ++checked;
   }
   std::printf("checked %d shadowed vertices in view; worst |ratio - attenuation| %.4f\n", checked, worst);
@@ -174,6 +183,60 @@ TEST(ShadowOverlay, VideoDarkensWhereTheLinesSayAndNowhereElse) {
   std::printf("%d pixels darkened, %d of them away from a predicted shadow\n", darker.changed, darker.unexplained);
   EXPECT_GT(darker.changed, 100);
   EXPECT_EQ(darker.unexplained, 0);
+}
+
+// Without the lines (CompositeFeatures::lines off, the 2004 baseline of the composite
+// measure), the floor darkens by the bounding-sphere method's attenuation, as
+// shadow_attenuation(..., ShadowMethod::Sphere) computes it for the same receivers and
+// pose: a darker, wider blob than the lines' shadow.
+TEST(ShadowOverlay, WithoutTheLinesTheFloorDarkensByThe2004Spheres) {
+  auto [camera, pose, scene] = sample_view();
+  scene.objects[0].T_world_model =
+      glm::translate(glm::dmat4(1.0), glm::dvec3(0, 0.12, 0)) * scene.objects[0].T_world_model;
+  Compositor compositor(std::make_shared<const LoadedScene>(scene), camera, cv::Mat(), cv::Mat());
+  gl::CompositeFeatures features;
+  features.bounce = false;
+  features.noise = features.blur = false;
+  const double exposure = 0.66;
+  const cv::Mat video = room_video(compositor, camera, pose, exposure);
+  compositor.set_features(features);
+  const cv::Mat lines = compositor.composite(video, pose, exposure);
+  features.lines = false;
+  compositor.set_features(features);
+  const cv::Mat spheres = compositor.composite(video, pose, exposure);
+  compositor.set_shadows_enabled(false);
+  const cv::Mat off = compositor.composite(video, pose, exposure);
+
+  const ShadowScene shadow_scene(scene);
+  const Mesh receivers = shadow_scene.receivers();
+  const std::vector<glm::vec3> expected =
+      shadow_attenuation(shadow_scene, receivers.positions, receivers.normals, ShadowMethod::Sphere);
+  const cv::Mat object_mask = compositor.renderer().render_object_mask(pose);
+  const cv::Mat lin_spheres = linear(spheres), lin_lines = linear(lines), lin_off = linear(off);
+  int checked = 0;
+  double worst = 0, sum_spheres = 0, sum_lines = 0;
+  for (std::size_t i = 0; i < receivers.positions.size(); ++i) {
+    if (expected[i].g > 0.9f) continue;
+    const auto at = receiver_pixel(receivers.positions[i], camera, pose, object_mask, lin_off);
+    if (!at) continue;
+    const float base = lin_off.at<cv::Vec3f>(*at)[1];
+    const double ratio = lin_spheres.at<cv::Vec3f>(*at)[1] / base;
+    worst = std::max(worst, std::abs(ratio - expected[i].g));
+    EXPECT_NEAR(ratio, expected[i].g, 0.06) << "vertex " << i << " at pixel " << at->x << "," << at->y;
+    sum_spheres += ratio, sum_lines += lin_lines.at<cv::Vec3f>(*at)[1] / base;
+    ++checked;
+  }
+  std::printf(
+      "%d receivers in view under the 2004 spheres' shadow; worst |ratio - sphere method| %.4f; mean ratio "
+      "%.3f (the lines there: %.3f)\n",
+      checked, worst, sum_spheres / std::max(1, checked), sum_lines / std::max(1, checked));
+  EXPECT_GE(checked, 10);
+  EXPECT_LT(sum_spheres, sum_lines);  // the bounding sphere blocks more than the mesh
+  // Back to the lines: their shadow again, to the bit.
+  features.lines = true;
+  compositor.set_features(features);
+  compositor.set_shadows_enabled(true);
+  EXPECT_EQ(cv::norm(compositor.composite(video, pose, exposure), lines, cv::NORM_INF), 0.0);
 }
 
 // A saturated red box beside the figurine: with bounce on, the floor around it turns

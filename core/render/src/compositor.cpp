@@ -21,6 +21,14 @@
 
 namespace lumar {
 
+struct Compositor::SphereShadows {
+  std::shared_ptr<const ShadowScene> scene;  // the proxy as rays
+  Mesh receivers;
+  Emitters emitters;
+  std::vector<glm::dmat4> poses;  // at the last trace; empty: never traced
+  std::vector<glm::vec3> attenuation;
+};
+
 Compositor::Compositor(std::shared_ptr<const LoadedScene> scene, const CameraIntrinsics& output_camera,
                        const cv::Mat& map_x, const cv::Mat& map_y, bool volume_cache)
     : camera_(output_camera.without_distortion()), scene_(std::move(scene)), cache_(volume_cache) {
@@ -98,7 +106,7 @@ void Compositor::set_features(const gl::CompositeFeatures& features) {
     std::fill(vertex_light_stale_.begin(), vertex_light_stale_.end(), 1);
     std::fill(lights_blocked_stale_.begin(), lights_blocked_stale_.end(), 1);
   }
-  if (before.bounce != features.bounce) shadows_uploaded_ = false;
+  if (before.bounce != features.bounce || before.lines != features.lines) shadows_uploaded_ = false;
 }
 
 // Precomputes the shadow lines from the scene's receivers to its emitters (the objects
@@ -153,6 +161,7 @@ void Compositor::set_shadow_quality(const ShadowQuality& quality) {
     throw InputError("shadow quality: emitter patches and lines per patch must be at least 1");
   shadow_quality_ = quality;
   shadows_.reset();
+  sphere_shadows_.reset();
   object_shadows_.reset();
   bounce_.reset();
   build_shadows();
@@ -295,6 +304,7 @@ FrameLight Compositor::prepare() {
   // The lines, the bounce and the objects' shadows on each other do not share state: they
   // run side by side (and the bounce over the receivers within).
   const bool lines = shadows_ && shadows_enabled_, bounce = lines && bounce_ && renderer_->features().bounce;
+  const bool spheres = lines && !renderer_->features().lines;
   const bool on_each_other = object_shadows_ && object_shadows_enabled_;
   bool lines_changed = false, bounce_changed = false, others_changed = false;
   {
@@ -302,11 +312,12 @@ FrameLight Compositor::prepare() {
     if (bounce) group.run([&] { bounce_changed = bounce_->update(object_irradiance(volume_.get(), sh_)); });
     if (on_each_other) group.run([&] { others_changed = object_shadows_->update(); });
     group.run_and_wait([&] {
-      if (lines) lines_changed = shadows_->update();
+      if (lines) lines_changed = spheres ? update_sphere_shadows() : shadows_->update();
     });
   }
   if (lines && (lines_changed || bounce_changed || !shadows_uploaded_)) {
-    light.receiver_attenuation = bounce ? with_bounce(shadows_->attenuation(), *bounce_) : shadows_->attenuation();
+    const std::vector<glm::vec3>& shadow = spheres ? sphere_shadows_->attenuation : shadows_->attenuation();
+    light.receiver_attenuation = bounce ? with_bounce(shadow, *bounce_) : shadow;
     light.object_bounce = object_bounce(bounce);
     shadows_uploaded_ = true;
   }
@@ -321,6 +332,25 @@ FrameLight Compositor::prepare() {
   light.shadows_ms = std::chrono::duration<double, std::milli>(t1 - t0).count();
   light.vertex_light_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t1).count();
   return light;
+}
+
+bool Compositor::update_sphere_shadows() {
+  if (!sphere_shadows_) {
+    auto built = std::make_shared<SphereShadows>();
+    built->scene = std::make_shared<ShadowScene>(scene_);
+    built->receivers = built->scene->receivers();
+    built->emitters =
+        built->scene->emitters(built->receivers.positions, built->receivers.normals, sphere_baseline_emitter_options());
+    sphere_shadows_ = std::move(built);
+  }
+  SphereShadows& s = *sphere_shadows_;
+  if (s.poses == poses_) return false;
+  std::vector<BoundingSphere> spheres;
+  for (std::size_t i = 0; i < poses_.size(); ++i)
+    spheres.push_back(bounding_sphere(scene_->objects[i].model, poses_[i]));
+  s.attenuation = sphere_attenuation(s.receivers.positions, s.receivers.normals, s.emitters, s.scene->proxy(), spheres);
+  s.poses = poses_;
+  return true;
 }
 
 void Compositor::forget_prepared() {

@@ -159,6 +159,11 @@ class Compositor {
   std::vector<glm::dvec3> object_points_;                // the above, posed
   void pose_object_points();
   std::shared_ptr<LineShadows> shadows_;  // shared_ptr: LineShadows is incomplete here
+  // With CompositeFeatures::lines off: the 2004 baseline's shadows on the same receivers,
+  // built at their first use, traced again whenever an object moved.
+  struct SphereShadows;
+  std::shared_ptr<SphereShadows> sphere_shadows_;
+  bool update_sphere_shadows();
   std::shared_ptr<ObjectShadows> object_shadows_;
   std::shared_ptr<ObjectBounce> bounce_;
   ShadowQuality shadow_quality_;

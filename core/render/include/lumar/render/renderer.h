@@ -62,6 +62,9 @@ struct CompositeFeatures {
   bool noise = true;           // VideoRadiometry's noise on rendered pixels
   bool blur = true;            // VideoRadiometry's blur on rendered pixels and their edges
   bool bounce = true;          // the objects' light reflected onto the receivers (the Compositor's)
+  // The objects' shadows on the room from the radiosity lines (the Compositor's); off:
+  // the 2004 system's, one line per bright patch against each object's bounding sphere.
+  bool lines = true;
 };
 
 class Renderer {
