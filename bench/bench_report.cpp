@@ -63,6 +63,21 @@ std::vector<double> log_ticks(double l0, double l1) {
   return {std::pow(10, 0.5 * (l0 + l1))};
 }
 
+// The plot's grid: a line and a label at each tick, px and py mapping values to pixels.
+template <class Px, class Py>
+void log_grid(cv::Mat& img, const cv::Rect& plot, const std::vector<double>& x_ticks,
+              const std::vector<double>& y_ticks, const Px& px, const Py& py) {
+  const int top = plot.y, bottom = plot.y + plot.height, left = plot.x, right = plot.x + plot.width;
+  for (const double v : x_ticks) {
+    cv::line(img, {px(v), top}, {px(v), bottom}, kGrid);
+    text(img, short_number(v), {px(v) - 8, bottom + 20}, 0.4);
+  }
+  for (const double v : y_ticks) {
+    cv::line(img, {left, py(v)}, {right, py(v)}, kGrid);
+    text(img, short_number(v), {10, py(v) + 5}, 0.4);
+  }
+}
+
 }  // namespace
 
 void BenchReport::write_chart(const std::filesystem::path& file) const {
@@ -103,20 +118,7 @@ void BenchReport::write_chart(const std::filesystem::path& file) const {
     auto py = [&](double e) {
       return bottom - int((bottom - top) * (std::log10(std::max(e, 1e-6)) - le0) / (le1 - le0));
     };
-    for (double d = lx0; d <= lx1; d += 1)
-      for (int m : {1, 2, 5}) {
-        const double v = m * std::pow(10, d);
-        if (v > std::pow(10, lx1)) break;
-        cv::line(img, {px(v), top}, {px(v), bottom}, kGrid);
-        text(img, short_number(v), {px(v) - 8, bottom + 20}, 0.4);
-      }
-    for (double d = le0; d <= le1; d += 1)
-      for (int m : {1, 2, 5}) {
-        const double v = m * std::pow(10, d);
-        if (v > std::pow(10, le1)) break;
-        cv::line(img, {left, py(v)}, {right, py(v)}, kGrid);
-        text(img, short_number(v), {10, py(v) + 5}, 0.4);
-      }
+    log_grid(img, {left, top, right - left, bottom - top}, log_ticks(lx0, lx1), log_ticks(le0, le1), px, py);
     cv::rectangle(img, {left, top}, {right, bottom}, kInk);
     text(img, x_label + " (log)", {(left + right) / 2 - 120, H - 45});
     text(img, error_label + " (log)", {left, top - 10}, 0.42);
@@ -170,14 +172,7 @@ void BenchReport::write_chart(const std::filesystem::path& file) const {
     auto py = [&](double e) {
       return bottom - int((bottom - top) * (std::log10(std::max(e, 1e-6)) - le0) / (le1 - le0));
     };
-    for (const double v : log_ticks(lt0, lt1)) {
-      cv::line(img, {px(v), top}, {px(v), bottom}, kGrid);
-      text(img, short_number(v), {px(v) - 8, bottom + 20}, 0.4);
-    }
-    for (const double v : log_ticks(le0, le1)) {
-      cv::line(img, {left, py(v)}, {right, py(v)}, kGrid);
-      text(img, short_number(v), {10, py(v) + 5}, 0.4);
-    }
+    log_grid(img, {left, top, right - left, bottom - top}, log_ticks(lt0, lt1), log_ticks(le0, le1), px, py);
     cv::rectangle(img, {left, top}, {right, bottom}, kInk);
     text(img, "time per operation (ms, log)", {(left + right) / 2 - 100, H - 25});
     text(img, error_label + " (log)", {left, top - 10}, 0.42);

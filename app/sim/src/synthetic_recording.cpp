@@ -314,10 +314,10 @@ void synthesize_recording(const SynthSettings& s) {
   // a map of 128 rows (its bright texels summed exactly, the rest by rays).
   std::unique_ptr<RoomRadiance> truth_room;
   std::unique_ptr<CompositeReference> truth;
-  // Where the objects' shadows fall: the surfaces the video shows. A distant map's
-  // radiance has no proxy, but the video shows it on the room's mesh (a ground plane).
   CompositeReferenceSettings truth_reference;
   truth_reference.object_strata = s.truth_strata;
+  // Where the objects' shadows fall: the surfaces the video shows. A distant map's
+  // radiance has no proxy, but the video shows it on the room's mesh (a ground plane).
   RayScene distant_map_ground;
   const RayScene* room_surfaces = nullptr;
   if (s.truth) {
