@@ -156,18 +156,21 @@ struct ProbeBuilder {
     }
   }
 
-  // Back faces seen and the nearest hit, from a few rays.
+  // Back faces seen and the nearest hit, from a few rays. Each starts a little behind p:
+  // a ray that starts exactly on a plane may pass through it, so a lattice node on the
+  // floor looked clear, kept its place, and its lower half saw through the floor.
   void quick_test(const glm::dvec3& p, int* back, double* nearest) const {
+    constexpr double kBehind = 1e-4;  // metres
     *back = 0;
     *nearest = std::numeric_limits<double>::infinity();
     const RayScene& rays = *radiance.ray_scene();
     for (const glm::dvec3& w : quick_directions) {
       Ray ray;
-      ray.origin = glm::vec3(p);
+      ray.origin = glm::vec3(p - w * kBehind);
       ray.direction = glm::vec3(w);
       const auto hit = rays.intersect(ray);
       if (!hit) continue;
-      *nearest = std::min(*nearest, double(hit->t));
+      *nearest = std::min(*nearest, std::max(0.0, double(hit->t) - kBehind));
       if (hit->back_face) ++*back;
     }
   }
