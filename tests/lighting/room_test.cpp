@@ -130,7 +130,7 @@ TEST(IrradianceRoom, ProbesOnTheFloorAreLiftedOffIt) {
 
 // A surface a few centimetres above the sample room's floor and facing down sees the
 // floor just below it, as the probes lifted off the floor do. (Closer than the probes,
-// the floor's pattern varies faster than they are spaced: 1 cm above it the error is
+// the floor's pattern varies faster than they are spaced: 1-3 cm above it the error is
 // 13 % on average.)
 TEST(IrradianceRoom, ADownwardNormalJustAboveTheFloorSeesTheFloorBelowIt) {
   const LoadedScene scene = load_scene_files(source_dir() / "data/scenes/room/scene.json");
