@@ -37,9 +37,7 @@ Difference difference(const std::vector<glm::dvec3>& value, const std::vector<gl
 TEST(FigurineLight, TheVolumeAndTheSelfOcclusionEachStayCloseToBruteForce) {
   const LoadedScene scene = load_scene_files(source_dir() / "data/scenes/room/scene.json");
   const IrradianceVolume volume = scene_irradiance_volume(scene, scene.manifest.lighting.method, false);
-  RadianceSettings settings = reference_radiance_settings();
-  settings.map_height = 128;  // the truth's map (lumar synth --truth)
-  const auto room = scene_radiance(scene, settings);
+  const auto room = scene_radiance(scene, truth_radiance_settings());
   const LoadedObject& figurine = scene.objects.at(0);
   const CompositeReference truth(*room, scene.objects);
 

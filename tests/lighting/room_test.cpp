@@ -10,6 +10,7 @@
 #include "lumar/base/constants.h"
 #include "lumar/base/error.h"
 #include "lumar/base/latlong.h"
+#include "lumar/lighting/composite_reference.h"
 #include "lumar/lighting/irradiance_reference.h"
 #include "lumar/lighting/irradiance_scene.h"
 #include "lumar/lighting/irradiance_volume.h"
@@ -135,9 +136,7 @@ TEST(IrradianceRoom, ProbesOnTheFloorAreLiftedOffIt) {
 TEST(IrradianceRoom, ADownwardNormalJustAboveTheFloorSeesTheFloorBelowIt) {
   const LoadedScene scene = load_scene_files(source_dir() / "data/scenes/room/scene.json");
   const IrradianceVolume volume = scene_irradiance_volume(scene, "volume", false);
-  RadianceSettings rs = reference_radiance_settings();
-  rs.map_height = 128;
-  const auto reference = scene_radiance(scene, rs);
+  const auto reference = scene_radiance(scene, truth_radiance_settings());
   std::vector<glm::dvec3> points, normals;
   for (double x : {-0.3, -0.1, 0.0, 0.1, 0.3})
     for (double z : {0.0, 0.3, 0.6})

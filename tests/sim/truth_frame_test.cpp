@@ -18,7 +18,7 @@
 #include "lumar/base/constants.h"
 #include "lumar/calib/camera_file.h"
 #include "lumar/capture/recording_reader.h"
-#include "lumar/lighting/irradiance_reference.h"
+#include "lumar/lighting/composite_reference.h"
 #include "lumar/lighting/irradiance_scene.h"
 #include "lumar/scene/loaded_scene.h"
 #include "lumar/sim/synthetic_recording.h"
@@ -159,9 +159,7 @@ TEST(TruthFrame, PerPixelObjectsConvergeAndVertexShadingIsCoarser) {
   // against 32² rays they differ by the rays' noise only, which the measure's 5×5 box
   // averages. E per vertex, interpolated, is systematically off by more (the knob's cost).
   const LoadedScene scene = load_scene_files(source_dir() / "data/scenes/room/scene.json");
-  RadianceSettings radiance = reference_radiance_settings();
-  radiance.map_height = 128;
-  const auto room = scene_radiance(scene, radiance);
+  const auto room = scene_radiance(scene, truth_radiance_settings());
   const CompositeReference reference(*room, scene.objects);
   CompositeReferenceSettings fine_settings;
   fine_settings.object_strata = 32;

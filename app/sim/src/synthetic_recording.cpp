@@ -17,7 +17,6 @@
 #include "lumar/capture/recording_writer.h"
 #include "lumar/capture/session.h"
 #include "lumar/lighting/composite_reference.h"
-#include "lumar/lighting/irradiance_reference.h"
 #include "lumar/lighting/irradiance_scene.h"
 #include "lumar/render/platform/context.h"
 #include "lumar/render/renderer.h"
@@ -322,9 +321,7 @@ void synthesize_recording(const SynthSettings& s) {
   const RayScene* room_surfaces = nullptr;
   if (s.truth) {
     if (scene.objects.empty()) throw InputError(s.scene.string() + ": --truth needs objects in the scene");
-    RadianceSettings radiance = reference_radiance_settings();
-    radiance.map_height = 128;
-    truth_room = scene_radiance(seen_scene, radiance);
+    truth_room = scene_radiance(seen_scene, truth_radiance_settings());
     truth = std::make_unique<CompositeReference>(*truth_room, seen_scene.objects, truth_reference);
     room_surfaces = truth_room->ray_scene();
     if (!room_surfaces) {

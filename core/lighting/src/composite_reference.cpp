@@ -20,6 +20,12 @@ glm::dvec3 vertex(const Mesh& m, std::uint32_t triangle, int k) {
 
 }  // namespace
 
+RadianceSettings truth_radiance_settings() {
+  RadianceSettings s = reference_radiance_settings();
+  s.map_height = 128;
+  return s;
+}
+
 CompositeReference::CompositeReference(const RoomRadiance& room, std::span<const LoadedObject> objects,
                                        const CompositeReferenceSettings& settings)
     : room_(room), settings_(settings), rays_(std::make_unique<RayScene>()) {

@@ -35,6 +35,10 @@ struct CompositeReferenceSettings {
   bool bounce = true;      // add the light objects reflect onto the room and onto each other
 };
 
+// The room's radiance the truth is lit by (`lumar synth --truth`): the reference's, from
+// a map of 128 rows, so that its bright texels stay few enough to sum exactly.
+RadianceSettings truth_radiance_settings();
+
 struct ObjectHit {
   int object = -1;
   double t = 0.0;           // along the ray, in the direction's units
