@@ -89,6 +89,9 @@ void register_synth(CLI::App& app) {
   cmd->add_flag("--truth", s->truth,
                 "Also write truth/: the frames with the scene's objects physically present, by brute force, and "
                 "their masks (docs/ground_truth.md)");
+  cmd->add_option("--truth-frames", s->truth_frames,
+                  "--truth: only these frames get truth, e.g. 0,15,31,47 (default: every frame)")
+      ->delimiter(',');
   cmd->add_option("--truth-seed", s->truth_seed,
                   "--truth: the noise seed of the second truth (truth/other-seed-*), the noise floor; 0 = --seed + 1")
       ->capture_default_str();

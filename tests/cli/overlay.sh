@@ -194,7 +194,8 @@ case_regress_sample() {
   "$LUMAR" regress "$REC" "$SRC/recordings/walk" | tee "$TMP/log" || fail "regression failed"
   [ "$(grep -c "^PASS" "$TMP/log")" -eq 2 ] || fail "expected two PASS lines (orbit, walk)"
   # Registration with the tracker's poses and with the video's help, by name for other tools.
-  "$LUMAR" regress --json "$REC" >"$TMP/json" 2>"$TMP/log" || { cat "$TMP/log"; fail "regress --json failed"; }
+  "$LUMAR" regress --json "$REC" "$SRC/recordings/walk" >"$TMP/json" 2>"$TMP/log" ||
+    { cat "$TMP/log"; fail "regress --json failed"; }
   python3 - "$TMP/json" <<'PY' || fail "registration keys"
 import json, sys
 r = json.loads(open(sys.argv[1]).read().splitlines()[0])
@@ -205,6 +206,19 @@ print("tracker %.2f px, fused %.2f px (p95 %.2f, %.2f)" % (r["tracker_mean_px"],
 assert r["fused_mean_px"] < 0.3 * r["tracker_mean_px"], "the video's help shows"
 assert r["fused_p95_px"] < r["tracker_p95_px"]
 assert r["fused_jump_px"] < 1.0 < r["tracker_jump_px"], "the fused poses do not jump, the tracker's do"
+PY
+  # The sample recordings carry their truth on the golden frames, and the composite
+  # against it is held to the limits in their expected.json.
+  python3 - "$TMP/json" <<'PY' || fail "the sample recordings' composite against their truth"
+import json, sys
+for line in open(sys.argv[1]).read().splitlines():
+    r = json.loads(line)
+    assert r["composite_frames"] == 4 and r["composite_failure"] is None, r
+    for region in ("object", "edge", "shadow"):
+        assert r[region + "_err"] < r["all_off_%s_err" % region] / 2, (r["recording"], region)
+    print("%s: object %.2f %%, edge %.2f %%, shadow %.2f %% (all off %.2f / %.2f / %.2f %%)" % (
+        r["recording"], r["object_err"], r["edge_err"], r["shadow_err"],
+        r["all_off_object_err"], r["all_off_edge_err"], r["all_off_shadow_err"]))
 PY
 }
 

@@ -85,6 +85,60 @@ PY
     "$LUMAR" synth --scene "$SCENE" --camera "$CAM" --out "$TMP/few" --frames 2 --truth --truth-strata 1
 }
 
+case_truth_on_some_frames_and_its_limits() {
+  # --truth-frames: truth for those frames only (a shipped recording keeps four), and
+  # regress measures just them. --update writes the composite's limits into expected.json
+  # and regress holds the composite to them.
+  "$LUMAR" synth --scene "$SCENE" --camera "$CAM" --out "$TMP/rec" --frames 3 --supersample 1 --truth \
+    --truth-frames 0,2 >"$TMP/log" 2>&1 || { cat "$TMP/log"; fail "synth --truth-frames failed"; }
+  local kind
+  for kind in frame other-seed empty mask; do
+    [ -e "$TMP/rec/truth/$kind-00000.png" ] && [ -e "$TMP/rec/truth/$kind-00002.png" ] ||
+      fail "truth/$kind of frames 0 and 2 missing"
+    [ ! -e "$TMP/rec/truth/$kind-00001.png" ] || fail "frame 1 got truth/$kind"
+  done
+  "$LUMAR" regress --update "$TMP/rec" >"$TMP/log" 2>&1 || { cat "$TMP/log"; fail "regress --update failed"; }
+  grep -q "composite thresholds for .*1.2 x measured + 0.2 points" "$TMP/log" ||
+    { cat "$TMP/log"; fail "the composite's thresholds were not explained"; }
+  "$LUMAR" regress --json "$TMP/rec" >"$TMP/json" 2>"$TMP/err" || { cat "$TMP/err"; fail "regress --json failed"; }
+  python3 - "$TMP/json" "$TMP/rec/expected.json" <<'PY' || fail "regress measured other frames, or wrote no limits"
+import json, sys
+r, e = json.load(open(sys.argv[1])), json.load(open(sys.argv[2]))
+assert r["composite_frames"] == 2, r["composite_frames"]
+c = e["composite"]
+lo, hi = c["noise_ratio_range"]
+assert lo <= 0.8 and hi >= 1.25 and lo <= r["noise_ratio"] <= hi, (c, r["noise_ratio"])
+for region in ("object", "edge", "shadow"):
+    err, limit = r[region + "_err"], c[region + "_err_max"]
+    assert err * 1.2 + 0.2 <= limit < err * 1.2 + 0.3, (region, err, limit)
+assert c["specks_max"] == r["specks"] + 2 and r["composite_failure"] is None
+print("ok: 2 frames measured; object %.2f %% (limit %.1f)" % (r["object_err"], c["object_err_max"]))
+PY
+  # A composite worse than its limit fails, and says which region.
+  cp "$TMP/rec/expected.json" "$TMP/expected.json"
+  python3 -c "import json; p='$TMP/rec/expected.json'; e=json.load(open(p)); e['composite']['object_err_max']=0.01; json.dump(e, open(p, 'w'))"
+  "$LUMAR" regress "$TMP/rec" >"$TMP/log" 2>&1
+  [ $? -eq 1 ] || { cat "$TMP/log"; fail "regress passed a composite over its object limit"; }
+  grep -q "composite over its limits: object error % [0-9.]* > 0.0" "$TMP/log" || { cat "$TMP/log"; fail "no reason"; }
+  cp "$TMP/expected.json" "$TMP/rec/expected.json"
+  # A frame with truth but without its mask: one error line.
+  mv "$TMP/rec/truth/mask-00002.png" "$TMP/mask.png"
+  expect_bad_input "mask-00002.png: missing or unreadable truth frame" "" -- "$LUMAR" regress "$TMP/rec"
+  mv "$TMP/mask.png" "$TMP/rec/truth/mask-00002.png"
+  # Limits without the truth they need: a failure, not a silent pass.
+  mv "$TMP/rec/truth" "$TMP/truth"
+  "$LUMAR" regress "$TMP/rec" >"$TMP/log" 2>&1
+  [ $? -eq 1 ] || { cat "$TMP/log"; fail "regress passed limits it could not measure"; }
+  grep -q "truth/ is missing" "$TMP/log" || { cat "$TMP/log"; fail "no reason"; }
+  # truth/ without any frame.
+  mkdir "$TMP/rec/truth"
+  expect_bad_input "no truth frame for any frame" "" -- "$LUMAR" regress "$TMP/rec"
+  expect_bad_input "--truth-frames: frame 3 is not among the 3 frames" "$TMP/bad" -- \
+    "$LUMAR" synth --scene "$SCENE" --camera "$CAM" --out "$TMP/bad" --frames 3 --truth --truth-frames 0,3
+  expect_bad_input "--truth-frames goes with --truth" "$TMP/bad" -- \
+    "$LUMAR" synth --scene "$SCENE" --camera "$CAM" --out "$TMP/bad" --frames 3 --truth-frames 0
+}
+
 case_truth_under_a_distant_sky_has_shadows() {
   # The courtyard: a distant map shown on a ground plane. The truth's objects cast their
   # shadows on that ground (before, a distant map meant no room to the truth: its

@@ -18,22 +18,28 @@ std::optional<TruthComparison> compare_with_truth(const std::filesystem::path& d
   const capture::Session& session = overlay.replay().session();
   const calib::UndistortionMaps maps = calib::make_undistortion_maps(session.camera, settings.overlay.undistortion);
   CompositeErrorMeter meter(calib::calibrated_response(session.radiometry, dir).value_or(calib::srgb_response(1.0)));
+  const auto file = [&](const char* kind, std::int64_t index) {
+    return truth / fmt::format("{}-{:05d}.png", kind, index);
+  };
   const auto read = [&](const char* kind, std::int64_t index, int flags) {
-    const std::filesystem::path file = truth / fmt::format("{}-{:05d}.png", kind, index);
-    const cv::Mat image = cv::imread(file.string(), flags);
-    if (image.empty()) throw InputError(file.string() + ": missing or unreadable truth frame");
+    const std::filesystem::path path = file(kind, index);
+    // Checked first: OpenCV would warn on its own line about a missing file.
+    const cv::Mat image = std::filesystem::exists(path) ? cv::imread(path.string(), flags) : cv::Mat();
+    if (image.empty()) throw InputError(path.string() + ": missing or unreadable truth frame");
     if (image.size() != maps.map_x.size())
-      throw InputError(file.string() + ": truth frame is " + std::to_string(image.cols) + "x" +
+      throw InputError(path.string() + ": truth frame is " + std::to_string(image.cols) + "x" +
                        std::to_string(image.rows) + ", not the video's size");
     return calib::undistort_image(image, maps);
   };
   const auto total_ms = [&] { return overlay.overlay().times().total(); };
   // The first frame pays for the shaders' compilation: timed from the second on.
   double after_first = 0;
-  int frames = 0;
+  int frames = 0, measured = 0;
   overlay.run(0, [&](const OverlayFrame& f) {
     if (frames++ == 0) after_first = total_ms();
-    if (!f.T_world_camera) return true;
+    // A frame has truth where its truth/frame-*.png is (synth --truth-frames).
+    if (!f.T_world_camera || !std::filesystem::exists(file("frame", f.index))) return true;
+    ++measured;
     const cv::Mat mask = read("mask", f.index, cv::IMREAD_GRAYSCALE) > 127;
     const cv::Mat frame = read("frame", f.index, cv::IMREAD_COLOR);
     meter.add(f.composite, frame, read("other-seed", f.index, cv::IMREAD_COLOR),
@@ -41,6 +47,7 @@ std::optional<TruthComparison> compare_with_truth(const std::filesystem::path& d
     if (visit) visit(f, frame, mask);
     return true;
   });
+  if (measured == 0) throw InputError(truth.string() + ": no truth frame for any frame of the video");
   const double ms = frames > 1 ? (total_ms() - after_first) / (frames - 1) : total_ms();
   return TruthComparison{meter.result(), ms, overlay.quality_choice()};
 }

@@ -234,6 +234,11 @@ void synthesize_recording(const SynthSettings& s) {
   if (s.fps <= 0) throw InputError("--fps: must be positive");
   if (s.truth_strata < 2 || s.truth_strata > 64)
     throw InputError(fmt::format("--truth-strata {}: use 2 to 64 (N*N rays per object pixel)", s.truth_strata));
+  if (!s.truth_frames.empty() && !s.truth) throw InputError("synth: --truth-frames goes with --truth");
+  for (int k : s.truth_frames)
+    if (k < 0 || k >= s.frames)
+      throw InputError(
+          fmt::format("--truth-frames: frame {} is not among the {} frames (0 to {})", k, s.frames, s.frames - 1));
   if (std::filesystem::exists(s.out))
     throw InputError(s.out.string() + ": already exists; choose a new recording directory");
   const LoadedScene scene = load_scene_files(s.scene);
@@ -362,7 +367,10 @@ void synthesize_recording(const SynthSettings& s) {
         // The video's own noise, drawn again for the truth, so that only the objects differ.
         cv::RNG same_noise = rng;
         const cv::Mat video = expose(calib::distort_image(radiance, pinhole, s.camera), s.camera, s, exposure, rng);
-        if (truth) {
+        const bool truth_here =
+            truth && (s.truth_frames.empty() ||
+                      std::find(s.truth_frames.begin(), s.truth_frames.end(), k) != s.truth_frames.end());
+        if (truth_here) {
           if (animated) {  // the objects where their paths are at this frame
             std::vector<LoadedObject> posed = scene.objects;
             for (LoadedObject& o : posed) o.T_world_model = o.pose_at(nanos_to_seconds(t));
@@ -372,7 +380,7 @@ void synthesize_recording(const SynthSettings& s) {
               render_truth_frame(*truth, *room_surfaces, pinhole, T_world_camera, radiance, truth_settings);
           const cv::Mat seen = calib::distort_image(frame.radiance, pinhole, s.camera);
           const std::filesystem::path dir = s.out / "truth";
-          if (k == 0) std::filesystem::create_directories(dir);
+          std::filesystem::create_directories(dir);
           const auto file = [&](const char* kind) { return dir / fmt::format("{}-{:05d}.png", kind, k); };
           calib::write_image_atomically(file("frame"),
                                         compress_like_video(expose(seen, s.camera, s, exposure, same_noise), s));

@@ -21,8 +21,10 @@ struct TruthComparison {
 // (for pictures).
 using TruthFrameVisitor = std::function<void(const OverlayFrame& frame, const cv::Mat& truth, const cv::Mat& mask)>;
 
-// nullopt when the recording has no truth/. `settings.poses` is set to the truth's.
-// InputError for a missing, unreadable or wrongly sized truth frame.
+// nullopt when the recording has no truth/; the frames measured are those with a
+// truth/frame-*.png (synth --truth-frames). `settings.poses` is set to the truth's.
+// InputError for a truth/ without frames, and for a missing, unreadable or wrongly
+// sized image of a frame that has truth.
 std::optional<TruthComparison> compare_with_truth(const std::filesystem::path& recording,
                                                   ReplayOverlaySettings settings, const TruthFrameVisitor& visit = {});
 

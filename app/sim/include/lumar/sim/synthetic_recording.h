@@ -43,6 +43,9 @@ struct SynthSettings {
   // truth/ beside the video: the same frames with the objects physically present
   // (docs/ground_truth.md), with the video's noise and with another seed's.
   bool truth = false;
+  // The frames that get truth (indices from 0); empty: every frame. A shipped recording
+  // keeps a few, as its truth is four images a frame.
+  std::vector<int> truth_frames;
   std::uint64_t truth_seed = 0;  // the other seed; 0: seed + 1
   int truth_ratio_stride = 4;    // TruthSettings::ratio_stride, in rendered (supersampled) pixels
   // Rays per object pixel of the truth: strata² (CompositeReferenceSettings::object_strata).
