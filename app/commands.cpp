@@ -23,7 +23,8 @@ void add_composite_options(CLI::App* cmd, CompositeOptions& o) {
       "--without", o.without,
       "Switch off what makes the objects look like the camera's pixels: a comma-separated list of "
       "antialiasing, self-occlusion, noise, blur, bounce, lines (the shadows' radiosity lines; without them, "
-      "the 2004 system's bounding-sphere shadows), or all (docs/ground_truth.md)");
+      "the 2004 system's bounding-sphere shadows), contact (the dense receivers where an object touches the floor), "
+      "or all (docs/ground_truth.md)");
   cmd->add_option("--blur-sigma", o.blur_sigma_px,
                   "The camera's blur as a Gaussian of this many output pixels (default: estimated from the video)")
       ->check(CLI::Range(0.0, 4.0));
@@ -77,11 +78,13 @@ void apply_composite_options(const CompositeOptions& o, pipeline::OverlaySetting
       f.bounce = false;
     else if (name == "lines")
       f.lines = false;
+    else if (name == "contact")
+      f.contact = false;
     else if (name == "all")
-      f = gl::CompositeFeatures{false, false, false, false, false, false};
+      f = gl::CompositeFeatures{false, false, false, false, false, false, false};
     else
       throw InputError("--without " + without + ": unknown feature '" + name +
-                       "'; use antialiasing, self-occlusion, noise, blur, bounce, lines or all");
+                       "'; use antialiasing, self-occlusion, noise, blur, bounce, lines, contact or all");
   }
   if (o.blur_sigma_px >= 0) settings.blur_sigma_px = o.blur_sigma_px;
   if (o.shading != "pixel" && o.shading != "vertex")

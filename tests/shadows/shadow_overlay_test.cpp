@@ -246,6 +246,74 @@ TEST(ShadowOverlay, WithoutTheLinesTheFloorDarkensByThe2004Spheres) {
   EXPECT_EQ(cv::norm(compositor.composite(video, pose, exposure), lines, cv::NORM_INF), 0.0);
 }
 
+// The figurine standing on the floor: once it has stood still, the contact receivers
+// under its feet darken the video by their own attenuation (the coarse receivers' shadow
+// times the patch's correction), where the coarse receivers alone left it lighter; moved,
+// the patch goes, and comes back under the new pose after Compositor::kRestFrames frames.
+TEST(ShadowOverlay, ContactReceiversDarkenTheFloorAtTheFeetAndFollowTheObject) {
+  auto [camera, pose, scene] = sample_view();
+  Compositor compositor(std::make_shared<const LoadedScene>(scene), camera, cv::Mat(), cv::Mat());
+  gl::CompositeFeatures features;
+  features.bounce = features.noise = features.blur = false;
+  compositor.set_features(features);
+  const double exposure = 0.66;
+  const cv::Mat video = room_video(compositor, camera, pose, exposure);
+  const cv::Mat on = compositor.composite(video, pose, exposure);
+  ASSERT_NE(compositor.contact_shadows(), nullptr);  // it never moved: at once
+  const LineShadows& contact = *compositor.contact_shadows();
+  features.contact = false;
+  compositor.set_features(features);
+  const cv::Mat coarse = compositor.composite(video, pose, exposure);
+  compositor.set_shadows_enabled(false);
+  const cv::Mat off = compositor.composite(video, pose, exposure);
+
+  const cv::Mat object_mask = compositor.renderer().render_object_mask(pose);
+  const cv::Mat lin_on = linear(on), lin_coarse = linear(coarse), lin_off = linear(off);
+  int checked = 0, agree = 0;
+  double sum_on = 0, sum_coarse = 0, sum_expected = 0;
+  for (std::size_t i = 0; i < contact.lines().origins.size(); ++i) {
+    const float expected = contact.attenuation()[i].g;
+    if (expected > 0.8f) continue;  // the contact shadow itself
+    const auto at = receiver_pixel(contact.lines().origins[i], camera, pose, object_mask, lin_off);
+    if (!at) continue;
+    const float base = lin_off.at<cv::Vec3f>(*at)[1];
+    const double ratio = lin_on.at<cv::Vec3f>(*at)[1] / base;
+    agree += std::abs(ratio - expected) < 0.06;
+    sum_on += ratio, sum_coarse += lin_coarse.at<cv::Vec3f>(*at)[1] / base, sum_expected += expected;
+    ++checked;
+  }
+  std::printf(
+      "%d contact receivers in view under the feet: mean ratio %.3f (their attenuation %.3f; the coarse "
+      "receivers alone %.3f); %d within 0.06\n",
+      checked, sum_on / std::max(1, checked), sum_expected / std::max(1, checked), sum_coarse / std::max(1, checked),
+      agree);
+  ASSERT_GE(checked, 10);
+  EXPECT_GE(agree, 0.9 * checked);
+  EXPECT_LT(sum_on, sum_coarse - 0.02 * checked);  // darker than the coarse receivers say, by 0.02 on average
+
+  // Moved 30 cm: no patch while it moves, one under the new pose once it rests.
+  glm::dvec3 centre(0.0), was(0.0);
+  for (const glm::vec3& p : contact.lines().origins) was += glm::dvec3(p);
+  was /= double(contact.lines().origins.size());
+  features.contact = true;
+  compositor.set_features(features);
+  compositor.set_shadows_enabled(true);
+  const glm::dmat4 moved = glm::translate(glm::dmat4(1.0), glm::dvec3(-0.3, 0, 0)) * scene.objects[0].T_world_model;
+  compositor.set_object_pose(0, moved);
+  for (int k = 0; k < Compositor::kRestFrames; ++k) {
+    compositor.composite(video, pose, exposure);
+    EXPECT_EQ(compositor.contact_shadows(), nullptr) << "frame " << k << " after the move";
+    EXPECT_TRUE(compositor.settling()) << "frame " << k << " after the move";
+  }
+  compositor.composite(video, pose, exposure);
+  ASSERT_NE(compositor.contact_shadows(), nullptr);
+  EXPECT_FALSE(compositor.settling());
+  for (const glm::vec3& p : compositor.contact_shadows()->lines().origins) centre += glm::dvec3(p);
+  centre /= double(compositor.contact_shadows()->lines().origins.size());
+  EXPECT_NEAR(centre.x - was.x, -0.3, 0.03);
+  EXPECT_NEAR(centre.z - was.z, 0.0, 0.03);
+}
+
 // A saturated red box beside the figurine: with bounce on, the floor around it turns
 // redder by what ObjectBounce says at each receiver vertex ((E_with + E_bounce) / E_with
 // against the same frame with bounce off), brighter in red than without the box's

@@ -275,10 +275,6 @@ TEST_F(OverlayWindow, PlaceSlideTurnShadowsSaveAndBadMeshes) {
   EXPECT_LT(glm::distance(after_turn, stood), 1e-6);
 
   // Shadows on, then off (H): each composite is the headless replay's of the saved scene.
-  const cv::Mat shown_on = screenshot("on.png");
-  press("h");
-  pause_for_frames();
-  const cv::Mat shown_off = screenshot("off.png");
   pipeline::ReplayOverlaySettings settings;
   settings.scene = turned_file;
   settings.poses = pipeline::PoseSource::Truth;
@@ -288,8 +284,20 @@ TEST_F(OverlayWindow, PlaceSlideTurnShadowsSaveAndBadMeshes) {
   headless.run(1, [&](const pipeline::OverlayFrame& f) { return want_on = f.composite.clone(), true; });
   headless.compositor().set_shadows_enabled(false);
   headless.run(1, [&](const pipeline::OverlayFrame& f) { return want_off = f.composite.clone(), true; });
+  // The replay's object never moved, so its contact shadows are there at once; the
+  // window's come once the turned object has stood still for a few frames, paused or not.
+  cv::Mat shown_on;
+  wait_until(
+      [&] {
+        shown_on = screenshot("on.png");
+        return shown_on.size() == want_on.size() && cv::PSNR(shown_on, want_on) >= 50.0;
+      },
+      10);
   ASSERT_EQ(shown_on.size(), want_on.size());
   EXPECT_GE(cv::PSNR(shown_on, want_on), 50.0);
+  press("h");
+  pause_for_frames();
+  const cv::Mat shown_off = screenshot("off.png");
   EXPECT_GE(cv::PSNR(shown_off, want_off), 50.0);
   // The floor beside the object's feet: darker with the shadow, as the replay says.
   const glm::dvec2 f = project(camera, pose, footprint(turned.objects[0]));

@@ -474,6 +474,8 @@ class OverlayUi {
     ImGui::SameLine();
     dirty_ |= ImGui::Checkbox("blur", &features_.blur);
     dirty_ |= ImGui::Checkbox("bounce (objects light the room)", &features_.bounce);
+    ImGui::SameLine();
+    dirty_ |= ImGui::Checkbox("contact shadows", &features_.contact);
     float exposure = float(overlay_.exposure_scale());
     if (ImGui::SliderFloat("exposure", &exposure, 0.25f, 4.0f, "%.2fx", ImGuiSliderFlags_Logarithmic))
       overlay_.set_exposure_scale(exposure), dirty_ = true;

@@ -87,6 +87,7 @@ class ReplayWindow {
     const pipeline::StageTimes before = overlay_.times();
     const pipeline::OverlayFrame out = overlay_.composite(frame_, replay_.camera_pose(frame_));
     ui_.show(out, before);
+    if (overlay_.compositor().settling()) ui_.set_dirty(true);  // paused: the contact shadows still to come
     // The first time the window reaches a frame in order (played, or stepped to): outputs,
     // and the frame budget.
     if (current_ == played_up_to_) {

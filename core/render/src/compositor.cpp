@@ -12,11 +12,13 @@
 #include "lumar/lighting/irradiance_volume.h"
 #include "lumar/lighting/light_self_shadow.h"
 #include "lumar/lighting/self_occlusion.h"
+#include "lumar/lighting/shadows/contact_receivers.h"
 #include "lumar/lighting/shadows/object_bounce.h"
 #include "lumar/lighting/shadows/object_shadows.h"
 #include "lumar/lighting/shadows/shadow_line_cache.h"
 #include "lumar/lighting/shadows/shadow_methods.h"
 #include "lumar/lighting/shadows/shadow_occlusion.h"
+#include "lumar/lighting/shadows/shadow_receivers.h"
 #include "lumar/lighting/vertex_irradiance.h"
 
 namespace lumar {
@@ -28,6 +30,17 @@ struct Compositor::SphereShadows {
   std::vector<glm::dmat4> poses;  // at the last trace; empty: never traced
   std::vector<glm::vec3> attenuation;
 };
+
+// The contact receivers for the poses they were built at, their lines, and the
+// correction they draw over the receivers' shadow.
+struct Compositor::ContactShadows {
+  std::vector<glm::dmat4> poses;
+  ContactPatch patch;  // empty: no object touches a receiver surface
+  std::unique_ptr<LineShadows> lines;
+  std::vector<glm::vec3> correction;
+};
+
+const LineShadows* Compositor::contact_shadows() const { return contact_ ? contact_->lines.get() : nullptr; }
 
 Compositor::Compositor(std::shared_ptr<const LoadedScene> scene, const CameraIntrinsics& output_camera,
                        const cv::Mat& map_x, const cv::Mat& map_y, bool volume_cache)
@@ -107,6 +120,7 @@ void Compositor::set_features(const gl::CompositeFeatures& features) {
     std::fill(lights_blocked_stale_.begin(), lights_blocked_stale_.end(), 1);
   }
   if (before.bounce != features.bounce || before.lines != features.lines) shadows_uploaded_ = false;
+  if (before.lines != features.lines || before.contact != features.contact) contact_uploaded_ = false;
 }
 
 // Precomputes the shadow lines from the scene's receivers to its emitters (the objects
@@ -131,6 +145,8 @@ void Compositor::build_shadows() {
   options.samples_per_patch = shadow_quality_.lines_per_patch;
   const Emitters emitters = shadow_scene.emitters(around.positions, around.normals, options);
   if (on_receivers) {
+    receivers_ = receivers;
+    emitters_ = std::make_shared<const Emitters>(emitters);
     shadows_ = std::make_shared<LineShadows>(
         cache_
             ? cached_shadow_lines(receivers.positions, receivers.normals, emitters, shadow_scene.proxy(), scene_->room)
@@ -164,6 +180,8 @@ void Compositor::set_shadow_quality(const ShadowQuality& quality) {
   sphere_shadows_.reset();
   object_shadows_.reset();
   bounce_.reset();
+  contact_.reset();
+  contact_uploaded_ = false;
   build_shadows();
   relight_shadows();
   shadows_uploaded_ = object_shadows_uploaded_ = false;
@@ -177,6 +195,7 @@ void Compositor::set_object_pose(std::size_t index, const glm::dmat4& T_world_mo
 void Compositor::move_object(std::size_t index, const glm::dmat4& T_world_model) {
   if (poses_.at(index) == T_world_model) return;
   poses_[index] = T_world_model;
+  frames_at_rest_ = 0;
   pose_object_points();
   vertex_light_stale_[index] = 1;
   lights_blocked_stale_[index] = 1;
@@ -202,6 +221,18 @@ void Compositor::set_lighting(const SceneLighting& lighting) {
 // the cell its direction from the map's capture point falls in.
 void Compositor::relight_shadows() {
   if (!shadows_ || light_scale_.rgb.size() <= 1) return;
+  const std::vector<glm::vec3> sample_scale = emitter_sample_scale();
+  shadows_->relight(sample_scale);
+  if (bounce_) bounce_->relight(shadows_->lines().unshadowed);
+  shadows_uploaded_ = false;
+  if (contact_ && contact_->lines) {
+    contact_->lines->relight(sample_scale);
+    contact_->correction = contact_->patch.correction(contact_->lines->attenuation(), shadows_->attenuation());
+    contact_uploaded_ = false;
+  }
+}
+
+std::vector<glm::vec3> Compositor::emitter_sample_scale() const {
   const ShadowLines& lines = shadows_->lines();
   const EnvironmentMap& map = scene_->map;
   std::vector<glm::vec3> sample_scale;
@@ -209,9 +240,51 @@ void Compositor::relight_shadows() {
   for (const EmitterPoint& e : lines.samples)  // distant: the position is the direction
     sample_scale.push_back(light_scale_.at(
         map.map_direction(lines.distant ? glm::dvec3(e.position) : glm::dvec3(e.position) - map.capture_position)));
-  shadows_->relight(sample_scale);
-  if (bounce_) bounce_->relight(shadows_->lines().unshadowed);
-  shadows_uploaded_ = false;
+  return sample_scale;
+}
+
+// Builds the contact receivers once the objects have stood still long enough, drops them
+// when one moves, and hands the renderer what changed.
+void Compositor::update_contact_shadows(FrameLight& light, bool lines_on) {
+  if (contact_ && contact_->poses != poses_) {
+    contact_.reset();
+    contact_uploaded_ = false;
+  }
+  const bool wanted = lines_on && renderer_->features().lines && renderer_->features().contact && emitters_;
+  if (wanted && !contact_ && frames_at_rest_ >= kRestFrames) {
+    const auto t0 = std::chrono::steady_clock::now();
+    auto built = std::make_shared<ContactShadows>();
+    built->poses = poses_;
+    const ShadowScene shadow_scene(scene_);
+    std::vector<SceneBox> regions = shadow_scene.regions().receivers;
+    if (regions.empty()) regions = default_receiver_regions(scene_->manifest, scene_->room);
+    std::vector<const Mesh*> models;
+    for (const LoadedObject& o : scene_->objects) models.push_back(&o.model);
+    const ContactSettings settings;
+    built->patch = build_contact_patch(shadow_scene.proxy(), receivers_,
+                                       contact_regions(regions, models, poses_, settings.reach), settings);
+    if (!built->patch.empty()) {
+      const Mesh& patch = built->patch.receivers;
+      built->lines = std::make_unique<LineShadows>(
+          build_shadow_lines(patch.positions, patch.normals, *emitters_, shadow_scene.proxy()));
+      for (std::size_t i = 0; i < poses_.size(); ++i) built->lines->add_object(scene_->objects[i].model, poses_[i]);
+      if (light_scale_.rgb.size() > 1) built->lines->relight(emitter_sample_scale());
+      built->lines->update();
+      built->correction = built->patch.correction(built->lines->attenuation(), shadows_->attenuation());
+      spdlog::debug("contact shadows: {} receivers, {} lines, built in {:.0f} ms", patch.positions.size(),
+                    built->lines->lines().lines.size(),
+                    std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+    }
+    contact_ = std::move(built);
+    contact_uploaded_ = false;
+  }
+  contact_pending_ = wanted && !contact_;
+  if (contact_uploaded_) return;
+  if (wanted && contact_ && contact_->lines)
+    light.contact = FrameLight::Contact{contact_->patch.receivers, contact_->correction};
+  else
+    light.contact = FrameLight::Contact{};
+  contact_uploaded_ = true;
 }
 
 void Compositor::set_object_shading(ObjectShading shading) {
@@ -275,7 +348,7 @@ std::vector<std::vector<glm::vec3>> Compositor::object_bounce(bool on) const {
 void Compositor::set_shadows_enabled(bool on, bool on_each_other) {
   if (on != shadows_enabled_) {
     shadows_enabled_ = on;
-    shadows_uploaded_ = false;
+    shadows_uploaded_ = contact_uploaded_ = false;
     if (shadows_ && !on) {
       renderer_->set_receiver_attenuation(std::vector<glm::vec3>(shadows_->attenuation().size(), glm::vec3(1.0f)));
       const auto none = object_bounce(false);
@@ -326,6 +399,8 @@ FrameLight Compositor::prepare() {
       light.object_shadowing.push_back(object_shadows_->vertex_attenuation(int(i)));
     object_shadows_uploaded_ = true;
   }
+  update_contact_shadows(light, lines && !spheres);
+  if (frames_at_rest_ < kRestFrames) ++frames_at_rest_;
   shadow_objects_themselves(light);
   const auto t1 = std::chrono::steady_clock::now();
   light_vertices(light);
@@ -354,7 +429,7 @@ bool Compositor::update_sphere_shadows() {
 }
 
 void Compositor::forget_prepared() {
-  shadows_uploaded_ = object_shadows_uploaded_ = false;
+  shadows_uploaded_ = object_shadows_uploaded_ = contact_uploaded_ = false;
   std::fill(vertex_light_stale_.begin(), vertex_light_stale_.end(), 1);
   std::fill(lights_blocked_stale_.begin(), lights_blocked_stale_.end(), 1);
 }
@@ -363,6 +438,7 @@ cv::Mat Compositor::render(const FrameLight& light, const cv::Mat& video_bgr8,
                            const std::optional<Pose>& T_world_camera, double exposure, gl::OverlayTimings* timings) {
   for (std::size_t i = 0; i < light.poses.size(); ++i) renderer_->set_object_pose(int(i), light.poses[i]);
   if (light.receiver_attenuation) renderer_->set_receiver_attenuation(*light.receiver_attenuation);
+  if (light.contact) renderer_->set_contact_receivers(light.contact->receivers, light.contact->correction);
   for (std::size_t i = 0; i < light.object_bounce.size(); ++i)
     renderer_->set_object_bounce_light(int(i), light.object_bounce[i]);
   for (std::size_t i = 0; i < light.object_shadowing.size(); ++i)

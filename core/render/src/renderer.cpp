@@ -169,6 +169,7 @@ struct Renderer::Impl {
   GlName background, depth_only, shaded_object, world_position, room_radiance, encode, blur, covered, antialias_resolve;
   GpuMesh room;
   std::unique_ptr<ShadowPass> receivers;  // shadow receivers, drawn over the video
+  std::unique_ptr<ShadowPass> contact;    // dense receivers where objects touch them, drawn after
   std::vector<Object> objects;
 
   GlName video;
@@ -416,6 +417,17 @@ void Renderer::set_receiver_attenuation(std::span<const glm::vec3> attenuation) 
   impl_->receivers->set_attenuation(attenuation);
 }
 
+void Renderer::set_contact_receivers(const Mesh& patch_world, std::span<const glm::vec3> correction) {
+  if (patch_world.indices.empty()) {
+    impl_->contact.reset();
+    return;
+  }
+  auto pass = std::make_unique<ShadowPass>();
+  pass->set_receivers(patch_world);
+  pass->set_attenuation(correction);
+  impl_->contact = std::move(pass);
+}
+
 void Renderer::set_environment(const EnvironmentMap& map) {
   if (map.width <= 0 || map.height <= 0 || map.rgb.size() != std::size_t(map.width) * map.height * 3)
     throw InputError("Renderer::set_environment: environment map is empty or its pixel count does not match " +
@@ -629,6 +641,7 @@ cv::Mat Renderer::render_overlay(const cv::Mat& video_bgr8, const std::optional<
     glDepthMask(GL_TRUE);
     r.draw_room_depth(vp);
     if (r.receivers) r.receivers->draw(vp);  // shadows on the video, before the objects
+    if (r.receivers && r.contact) r.contact->draw(vp);
     clock.mark(&t.depth_ms);
 
     // Depth first, then shade only the nearest surface: the per-pixel lighting is the

@@ -20,6 +20,7 @@ class ObjectShadows;
 class ObjectBounce;
 class IrradianceVolume;
 class LightSelfShadow;
+struct Emitters;
 struct VertexOcclusion;
 
 // The shadows' quality knobs (docs/shadows.md): how many emitter patches the map is split
@@ -51,6 +52,13 @@ struct FrameLight {
   std::vector<std::vector<glm::vec3>> object_shadowing;                  // per object: the others' shadow on it
   std::vector<std::optional<std::vector<glm::vec3>>> vertex_irradiance;  // per object (ObjectShading::PerVertex)
   std::vector<std::optional<std::vector<float>>> lights_blocked;         // per object: its shadow on itself
+  // The contact receivers and their correction of the receivers' shadow; an empty mesh
+  // removes them (ContactShadows below).
+  struct Contact {
+    Mesh receivers;
+    std::vector<glm::vec3> correction;
+  };
+  std::optional<Contact> contact;
   double shadows_ms = 0, vertex_light_ms = 0;
 };
 
@@ -115,6 +123,15 @@ class Compositor {
   const ObjectShadows* object_shadows() const { return object_shadows_.get(); }
   // The objects' light on the receivers, or nullptr when the scene has no receivers.
   const ObjectBounce* bounce() const { return bounce_.get(); }
+  // The contact receivers' lines (lighting/shadows/contact_receivers.h), or nullptr while
+  // there are none: they are built once the objects have stood still for kRestFrames
+  // prepared frames (at once for objects that never move), and dropped when one moves,
+  // since a patch at every pose of a moving object would cost a build per frame.
+  static constexpr int kRestFrames = 3;
+  const LineShadows* contact_shadows() const;
+  // True while contact receivers are wanted but not built yet: preparing the same frame
+  // again brings them nearer, so a paused window keeps compositing until it is false.
+  bool settling() const { return contact_pending_; }
 
   // The room's light changed (pipeline/live_lighting.h): shade the objects from this
   // lighting (relit_scene_lighting, or a blend of two), and scale the shadow lines'
@@ -165,6 +182,15 @@ class Compositor {
   std::shared_ptr<SphereShadows> sphere_shadows_;
   bool update_sphere_shadows();
   std::shared_ptr<ObjectShadows> object_shadows_;
+  Mesh receivers_;                            // the lines' receivers
+  std::shared_ptr<const Emitters> emitters_;  // the lines' emitters
+  struct ContactShadows;
+  std::shared_ptr<ContactShadows> contact_;
+  int frames_at_rest_ = kRestFrames;  // prepared frames since an object last moved
+  bool contact_uploaded_ = false;
+  bool contact_pending_ = false;
+  void update_contact_shadows(FrameLight& light, bool lines_on);
+  std::vector<glm::vec3> emitter_sample_scale() const;
   std::shared_ptr<ObjectBounce> bounce_;
   ShadowQuality shadow_quality_;
   MapCellScale light_scale_;  // the room's change since the map was captured (set_lighting)

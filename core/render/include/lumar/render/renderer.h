@@ -65,6 +65,9 @@ struct CompositeFeatures {
   // The objects' shadows on the room from the radiosity lines (the Compositor's); off:
   // the 2004 system's, one line per bright patch against each object's bounding sphere.
   bool lines = true;
+  // With the lines: a dense patch of receivers where an object rests on a receiver
+  // surface, for the contact shadow the lines' coarse receivers blur (the Compositor's).
+  bool contact = true;
 };
 
 class Renderer {
@@ -115,6 +118,10 @@ class Renderer {
   // An empty mesh removes them.
   void set_receivers(const Mesh& receivers_world);
   void set_receiver_attenuation(std::span<const glm::vec3> attenuation);
+  // A second, denser receiver mesh where objects touch a receiver surface
+  // (lighting/shadows/contact_receivers.h), drawn the same way after the receivers: its
+  // per-vertex `correction` multiplies their shadow. An empty mesh removes it.
+  void set_contact_receivers(const Mesh& patch_world, std::span<const glm::vec3> correction);
 
   // Where each output pixel samples the distorted video: cv::initUndistortRectifyMap's
   // map1/map2 as CV_32FC1, output size. Without it the video is drawn unwarped
