@@ -2,8 +2,9 @@
 // overlay` runs (pipeline/replay_overlay.h: the session's radiometry, the tracker's poses):
 // time per stage, and replay throughput. Baseline: decoding one video frame, measured in
 // the same run. The composite is timed with every feature that makes it look like the
-// camera's pixels (antialiasing, self-occlusion, noise, blur: docs/ground_truth.md) and
-// again with them all off, so that their cost is a ratio from the same run. The walk
+// camera's pixels (antialiasing, self-occlusion, noise, blur, contact shadows:
+// docs/ground_truth.md), with all but the contact shadows, and with them all off, so that
+// their cost is a ratio from the same run. The walk
 // recording adds moving objects: the figurine walks across the floor beside a second
 // one, so its shadow on the floor and on the other object is traced again every frame.
 // Throughput: both recordings replayed whole as `lumar overlay` does, today's serial path
@@ -12,6 +13,8 @@
 #include <benchmark/benchmark.h>
 #include <unistd.h>
 
+#include <array>
+#include <chrono>
 #include <map>
 
 #include "bench_report.h"
@@ -25,14 +28,20 @@ namespace {
 const std::filesystem::path kRecording = std::filesystem::path(LUMAR_SOURCE_DIR) / "recordings/orbit";
 const std::filesystem::path kWalk = std::filesystem::path(LUMAR_SOURCE_DIR) / "recordings/walk";
 
-pipeline::ReplayOverlaySettings with_features(bool on) {
+// Which of the features that make the composite look real are on (the shadow lines and
+// the bounce stay on in all three).
+enum class Look { All, NoContact, Off };
+
+pipeline::ReplayOverlaySettings with_look(Look look) {
   pipeline::ReplayOverlaySettings s;
-  if (!on) s.overlay.features = {false, false, false, false};
+  gl::CompositeFeatures& f = s.overlay.features;
+  f.contact = look == Look::All;
+  if (look == Look::Off) f.antialiasing = f.self_occlusion = f.noise = f.blur = false;
   return s;
 }
 
 struct Fixture {
-  explicit Fixture(bool features = true) : overlay(kRecording, with_features(features)) {}
+  explicit Fixture(Look look) : overlay(kRecording, with_look(look)) {}
   pipeline::ReplayOverlay overlay;
   std::unique_ptr<capture::FrameSource> frames = overlay.replay().open_frames();
   capture::Frame frame;
@@ -47,14 +56,11 @@ struct Fixture {
   }
 };
 
-Fixture& fixture() {
-  static Fixture f;
-  return f;
-}
-
-Fixture& plain_fixture() {
-  static Fixture f(false);
-  return f;
+Fixture& fixture(Look look = Look::All) {
+  static std::map<Look, std::unique_ptr<Fixture>> fixtures;
+  auto& f = fixtures[look];
+  if (!f) f = std::make_unique<Fixture>(look);
+  return *f;
 }
 
 void decode_frame(benchmark::State& state) {
@@ -63,11 +69,12 @@ void decode_frame(benchmark::State& state) {
 }
 
 // One frame again and again: the rendering stages alone.
-void composite_frame(benchmark::State& state, bool features) {
-  auto& f = features ? fixture() : plain_fixture();
+void composite_frame(benchmark::State& state) {
+  auto& f = fixture();
   const capture::Frame frame = f.next();
   const auto pose = f.overlay.replay().tracked_camera_pose(frame.time);
   pipeline::Overlay& overlay = f.overlay.overlay();
+  overlay.composite(frame, pose);  // outside the clock: the first builds the contact shadows
   const pipeline::StageTimes before = overlay.times();
   for (auto _ : state) benchmark::DoNotOptimize(overlay.composite(frame, pose).composite.data);
   const pipeline::StageTimes& after = overlay.times();
@@ -79,6 +86,36 @@ void composite_frame(benchmark::State& state, bool features) {
   state.counters["antialiasing_ms"] = C(after.antialiasing - before.antialiasing, C::kAvgIterations);
   state.counters["blur_ms"] = C(after.blur - before.blur, C::kAvgIterations);
   state.counters["readback_ms"] = C(after.readback - before.readback, C::kAvgIterations);
+}
+
+// The look-real features' cost: the same frame composited with all of them, without the
+// contact shadows and with none, in turn within each iteration (the order rotating), so
+// that the machine's drift during the run falls on all three alike.
+void look_costs(benchmark::State& state) {
+  const std::array<Look, 3> looks{Look::All, Look::NoContact, Look::Off};
+  std::array<capture::Frame, 3> frames;
+  std::array<std::optional<Pose>, 3> poses;
+  for (int i = 0; i < 3; ++i) {
+    Fixture& f = fixture(looks[i]);
+    frames[i] = f.next();
+    poses[i] = f.overlay.replay().tracked_camera_pose(frames[i].time);
+    f.overlay.overlay().composite(frames[i], poses[i]);  // the first builds the contact shadows
+  }
+  std::array<double, 3> ms{};
+  int start = 0;
+  for (auto _ : state) {
+    for (int k = 0; k < 3; ++k) {
+      const int i = (start + k) % 3;
+      const auto t0 = std::chrono::steady_clock::now();
+      benchmark::DoNotOptimize(fixture(looks[i]).overlay.overlay().composite(frames[i], poses[i]).composite.data);
+      ms[i] += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    }
+    start = (start + 1) % 3;
+  }
+  using C = benchmark::Counter;
+  state.counters["all_ms"] = C(ms[0], C::kAvgIterations);
+  state.counters["without_contact_ms"] = C(ms[1], C::kAvgIterations);
+  state.counters["off_ms"] = C(ms[2], C::kAvgIterations);
 }
 
 // The quality knobs of a replay: full quality per pixel, the same per vertex, or what
@@ -152,14 +189,11 @@ int main(int argc, char** argv) {
       ->Unit(benchmark::kMillisecond)
       ->MinTime(1.0)
       ->UseRealTime();
-  benchmark::RegisterBenchmark("composite_frame", composite_frame, true)
+  benchmark::RegisterBenchmark("composite_frame", composite_frame)
       ->Unit(benchmark::kMillisecond)
       ->MinTime(2.0)
       ->UseRealTime();
-  benchmark::RegisterBenchmark("composite_frame_features_off", composite_frame, false)
-      ->Unit(benchmark::kMillisecond)
-      ->MinTime(2.0)
-      ->UseRealTime();
+  benchmark::RegisterBenchmark("look_costs", look_costs)->Unit(benchmark::kMillisecond)->MinTime(6.0)->UseRealTime();
   std::vector<Throughput> throughputs;
   for (bool walk : {false, true})
     for (const Throughput& t :
@@ -179,8 +213,10 @@ int main(int argc, char** argv) {
 
   const auto* decode = reporter.find("decode_frame");
   const auto* composite = reporter.find("composite_frame");
-  const auto* plain = reporter.find("composite_frame_features_off");
-  if (!decode || !composite || !plain) return 0;  // a filtered run: no report
+  const auto* looks = reporter.find("look_costs");
+  if (!decode || !composite || !looks) return 0;  // a filtered run: no report
+  const double all_ms = looks->counters.at("all_ms"), no_contact_ms = looks->counters.at("without_contact_ms"),
+               off_ms = looks->counters.at("off_ms");
   // A replay's time per frame (nullopt: not run).
   const auto ms_per_frame = [&](const Throughput& t) -> std::optional<double> {
     const auto* r = reporter.find("throughput/" + t.name());
@@ -204,7 +240,9 @@ int main(int argc, char** argv) {
                     {"camera blur", c.at("blur_ms")},
                     {"read back", c.at("readback_ms")},
                     {"composite, all stages", composite->time_ms},
-                    {"composite, features off", plain->time_ms},
+                    {"look-real features on (in turn)", all_ms},
+                    {"  ... without contact shadows", no_contact_ms},
+                    {"  ... all of them off", off_ms},
                     {"replay: decode+pose+composite", replay_ms}};
   // The walk shaded per pixel: per stage, over its replays (the overlay's own stage clock).
   const pipeline::StageTimes& w = throughput_overlay(true, Knobs::PerPixel).times();
@@ -247,8 +285,8 @@ int main(int argc, char** argv) {
       "shadows; the 2004 system: 0.8-0.9 frames/s with moving shadows\n",
       1000.0 / walk_ms, walk_ms, w.shadows / walk_frames);
   std::printf(
-      "antialiasing, self-occlusion, noise and blur: %.2f ms per 640x480 frame (composite %.2f ms, %.2f x the %.2f ms "
-      "with them off)\n",
-      composite->time_ms - plain->time_ms, composite->time_ms, composite->time_ms / plain->time_ms, plain->time_ms);
+      "antialiasing, self-occlusion, noise, blur and contact shadows: %+.2f ms per 640x480 frame (composite %.2f ms, "
+      "%.3f x the %.2f ms with them off); contact shadows alone: %+.2f ms (%.3f x)\n",
+      all_ms - off_ms, all_ms, all_ms / off_ms, off_ms, all_ms - no_contact_ms, all_ms / no_contact_ms);
   return 0;
 }

@@ -18,13 +18,11 @@
 #include "lumar/lighting/shadows/shadow_line_cache.h"
 #include "lumar/lighting/shadows/shadow_methods.h"
 #include "lumar/lighting/shadows/shadow_occlusion.h"
-#include "lumar/lighting/shadows/shadow_receivers.h"
 #include "lumar/lighting/vertex_irradiance.h"
 
 namespace lumar {
 
 struct Compositor::SphereShadows {
-  std::shared_ptr<const ShadowScene> scene;  // the proxy as rays
   Mesh receivers;
   Emitters emitters;
   std::vector<glm::dmat4> poses;  // at the last trace; empty: never traced
@@ -123,11 +121,16 @@ void Compositor::set_features(const gl::CompositeFeatures& features) {
   if (before.lines != features.lines || before.contact != features.contact) contact_uploaded_ = false;
 }
 
+const ShadowScene& Compositor::shadow_scene() {
+  if (!shadow_scene_) shadow_scene_ = std::make_shared<const ShadowScene>(scene_);
+  return *shadow_scene_;
+}
+
 // Precomputes the shadow lines from the scene's receivers to its emitters (the objects
 // are the occluders), and with two objects or more their shadows on each other.
 void Compositor::build_shadows() {
   const auto t0 = std::chrono::steady_clock::now();
-  const ShadowScene shadow_scene(scene_);
+  const ShadowScene& shadow_scene = this->shadow_scene();
   const auto& objects = shadow_scene.objects();
   const Mesh receivers = shadow_scene.receivers();
   const bool on_receivers = receivers.triangle_count() > 0 && !objects.empty();
@@ -255,14 +258,13 @@ void Compositor::update_contact_shadows(FrameLight& light, bool lines_on) {
     const auto t0 = std::chrono::steady_clock::now();
     auto built = std::make_shared<ContactShadows>();
     built->poses = poses_;
-    const ShadowScene shadow_scene(scene_);
-    std::vector<SceneBox> regions = shadow_scene.regions().receivers;
-    if (regions.empty()) regions = default_receiver_regions(scene_->manifest, scene_->room);
+    const ShadowScene& shadow_scene = this->shadow_scene();
     std::vector<const Mesh*> models;
     for (const LoadedObject& o : scene_->objects) models.push_back(&o.model);
     const ContactSettings settings;
-    built->patch = build_contact_patch(shadow_scene.proxy(), receivers_,
-                                       contact_regions(regions, models, poses_, settings.reach), settings);
+    built->patch =
+        build_contact_patch(shadow_scene.proxy(), receivers_,
+                            contact_regions(shadow_scene.receiver_regions(), models, poses_, settings.reach), settings);
     if (!built->patch.empty()) {
       const Mesh& patch = built->patch.receivers;
       built->lines = std::make_unique<LineShadows>(
@@ -412,10 +414,9 @@ FrameLight Compositor::prepare() {
 bool Compositor::update_sphere_shadows() {
   if (!sphere_shadows_) {
     auto built = std::make_shared<SphereShadows>();
-    built->scene = std::make_shared<ShadowScene>(scene_);
-    built->receivers = built->scene->receivers();
-    built->emitters =
-        built->scene->emitters(built->receivers.positions, built->receivers.normals, sphere_baseline_emitter_options());
+    built->receivers = shadow_scene().receivers();
+    built->emitters = shadow_scene().emitters(built->receivers.positions, built->receivers.normals,
+                                              sphere_baseline_emitter_options());
     sphere_shadows_ = std::move(built);
   }
   SphereShadows& s = *sphere_shadows_;
@@ -423,7 +424,8 @@ bool Compositor::update_sphere_shadows() {
   std::vector<BoundingSphere> spheres;
   for (std::size_t i = 0; i < poses_.size(); ++i)
     spheres.push_back(bounding_sphere(scene_->objects[i].model, poses_[i]));
-  s.attenuation = sphere_attenuation(s.receivers.positions, s.receivers.normals, s.emitters, s.scene->proxy(), spheres);
+  s.attenuation =
+      sphere_attenuation(s.receivers.positions, s.receivers.normals, s.emitters, shadow_scene().proxy(), spheres);
   s.poses = poses_;
   return true;
 }

@@ -167,10 +167,13 @@ ShadowScene::ShadowScene(EnvironmentMap map, bool distant, Mesh room_world, std:
     : ShadowScene(
           scene_of_parts(std::move(map), distant, std::move(room_world), std::move(objects), std::move(regions))) {}
 
+std::vector<SceneBox> ShadowScene::receiver_regions() const {
+  if (!regions().receivers.empty()) return regions().receivers;
+  return default_receiver_regions(scene_->manifest, scene_->room);
+}
+
 Mesh ShadowScene::receivers() const {
-  std::vector<SceneBox> boxes = regions().receivers;
-  if (boxes.empty()) boxes = default_receiver_regions(scene_->manifest, scene_->room);
-  return build_receivers(*proxy_, boxes, regions().receiver_vertices);
+  return build_receivers(*proxy_, receiver_regions(), regions().receiver_vertices);
 }
 
 Emitters ShadowScene::emitters(const std::vector<glm::vec3>& positions, const std::vector<glm::vec3>& normals,

@@ -20,6 +20,7 @@ class ObjectShadows;
 class ObjectBounce;
 class IrradianceVolume;
 class LightSelfShadow;
+class ShadowScene;
 struct Emitters;
 struct VertexOcclusion;
 
@@ -159,6 +160,9 @@ class Compositor {
   SH9 sh_;
   std::unique_ptr<gl::Renderer> renderer_;
   std::shared_ptr<const IrradianceVolume> volume_;  // shared_ptr: incomplete here
+  // The scene's proxy as rays, built at its first use and shared by every shadow method.
+  std::shared_ptr<const ShadowScene> shadow_scene_;  // shared_ptr: incomplete here
+  const ShadowScene& shadow_scene();
   void build_shadows();
   bool cache_ = true;  // the volume and the shadow lines from the disk cache
   void bake_self_occlusion_once();

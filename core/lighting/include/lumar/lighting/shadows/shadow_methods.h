@@ -68,7 +68,9 @@ class ShadowScene {
   const std::vector<Object>& objects() const { return scene_->objects; }
   const ShadowRegions& regions() const { return scene_->manifest.shadows; }
 
-  // The receiver mesh: the manifest's receiver boxes, or the floor under the movement box.
+  // Where shadows fall: the manifest's receiver boxes, or the floor under the movement box.
+  std::vector<SceneBox> receiver_regions() const;
+  // The receiver mesh over receiver_regions().
   Mesh receivers() const;
   // Emitters ranked for receivers around these points (their mean position and normal).
   Emitters emitters(const std::vector<glm::vec3>& positions, const std::vector<glm::vec3>& normals,
