@@ -24,10 +24,17 @@ void add_composite_options(CLI::App* cmd, CompositeOptions& o) {
       "Switch off what makes the objects look like the camera's pixels: a comma-separated list of "
       "antialiasing, self-occlusion, noise, blur, bounce, lines (the shadows' radiosity lines; without them, "
       "the 2004 system's bounding-sphere shadows), contact (the dense receivers where an object touches the floor), "
-      "or all (docs/ground_truth.md)");
+      "motion-blur (the objects drawn over the shutter's time), or all (docs/ground_truth.md)");
   cmd->add_option("--blur-sigma", o.blur_sigma_px,
                   "The camera's blur as a Gaussian of this many output pixels (default: estimated from the video)")
       ->check(CLI::Range(0.0, 4.0));
+  cmd->add_option("--shutter", o.shutter_s,
+                  "How long the camera's shutter was open per frame, seconds, for the objects' motion blur "
+                  "(default: the session's radiometry.shutter_s; 0: no motion blur)");
+  cmd->add_option("--shutter-instants", o.shutter_instants,
+                  "Motion blur: the instants of the shutter the objects are drawn at and averaged over (each costs "
+                  "one more drawing of them)")
+      ->capture_default_str();
   cmd->add_option("--shading", o.shading,
                   "Where the objects' light from the irradiance volume is evaluated: pixel (every covered pixel) or "
                   "vertex (their vertices, again only when they move; docs/irradiance.md)")
@@ -80,13 +87,26 @@ void apply_composite_options(const CompositeOptions& o, pipeline::OverlaySetting
       f.lines = false;
     else if (name == "contact")
       f.contact = false;
+    else if (name == "motion-blur")
+      f.motion_blur = false;
     else if (name == "all")
-      f = gl::CompositeFeatures{false, false, false, false, false, false, false};
+      f = gl::CompositeFeatures{false, false, false, false, false, false, false, false};
     else
       throw InputError("--without " + without + ": unknown feature '" + name +
-                       "'; use antialiasing, self-occlusion, noise, blur, bounce, lines, contact or all");
+                       "'; use antialiasing, self-occlusion, noise, blur, bounce, lines, contact, motion-blur or all");
   }
   if (o.blur_sigma_px >= 0) settings.blur_sigma_px = o.blur_sigma_px;
+  if (o.shutter_s != -1.0) {
+    if (!(o.shutter_s >= 0.0 && o.shutter_s <= 1.0))
+      throw InputError(fmt::format("--shutter {}: use 0 (no motion blur) to 1 second", o.shutter_s));
+    settings.shutter_s = o.shutter_s;
+  }
+  if (o.shutter_instants < pipeline::OverlaySettings::kMinShutterInstants ||
+      o.shutter_instants > pipeline::OverlaySettings::kMaxShutterInstants)
+    throw InputError(fmt::format("--shutter-instants {}: use {} to {}", o.shutter_instants,
+                                 pipeline::OverlaySettings::kMinShutterInstants,
+                                 pipeline::OverlaySettings::kMaxShutterInstants));
+  settings.shutter_instants = o.shutter_instants;
   if (o.shading != "pixel" && o.shading != "vertex")
     throw InputError("--shading " + o.shading + ": use pixel or vertex");
   pipeline::OverlayQuality& q = settings.quality;

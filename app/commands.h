@@ -31,6 +31,8 @@ void add_live_input_options(
 struct CompositeOptions {
   std::string without;
   double blur_sigma_px = -1.0;
+  double shutter_s = -1.0;  // -1: the session's
+  int shutter_instants = pipeline::OverlaySettings{}.shutter_instants;
   std::string shading = "pixel";
   int shadow_lines = ShadowQuality{}.lines_per_patch;
   int exact_lights = -1;  // -1: the manifest's

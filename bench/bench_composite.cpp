@@ -97,7 +97,7 @@ int main() {
   for (int bits = -1; bits < 16; ++bits) {
     pipeline::ReplayOverlaySettings settings;
     if (bits < 0)
-      settings.overlay.features = gl::CompositeFeatures{false, false, false, false, false, false, false};
+      settings.overlay.features = gl::CompositeFeatures{false, false, false, false, false, false, false, false};
     else
       settings.overlay.features = {bool(bits & 1), bool(bits & 2), bool(bits & 4), bool(bits & 8)};
     const std::string name = bits < 0 ? k2004 : name_of(settings.overlay.features);
@@ -121,16 +121,8 @@ int main() {
   bench::publish_stacked(reports, "composite_error_vs_cost.png");
 
   // The last frame's feet, 4 times enlarged: before, after, truth.
-  const cv::Rect crop = feet(mask);
-  std::vector<cv::Mat> parts;
-  for (const cv::Mat& image : {before, after, truth}) {
-    cv::Mat big;
-    cv::resize(image(crop), big, {}, 4, 4, cv::INTER_NEAREST);
-    parts.push_back(big);
-  }
-  cv::Mat picture;
-  cv::hconcat(parts, picture);
-  calib::write_image_atomically(kSource / "docs/composite_before_after_truth.png", picture);
+  calib::write_image_atomically(kSource / "docs/composite_before_after_truth.png",
+                                bench::crops_side_by_side({before, after, truth}, feet(mask), 4));
   // The same frame with the open scan the solid was made from: its cracks show back faces
   // and, in its truth, a hollow inside (docs/solid.md). Against the solid's truth, so the
   // errors say how far the scan's composite is from the closed figurine's look.
@@ -146,14 +138,8 @@ int main() {
   const cv::Rect box = cv::boundingRect(mask);
   const cv::Rect upper =
       cv::Rect(box.x - 6, box.y - 6, box.width + 12, box.height * 3 / 5) & cv::Rect(0, 0, mask.cols, mask.rows);
-  parts.clear();
-  for (const cv::Mat& image : {scan, after, truth}) {
-    cv::Mat big;
-    cv::resize(image(upper), big, {}, 3, 3, cv::INTER_NEAREST);
-    parts.push_back(big);
-  }
-  cv::hconcat(parts, picture);
-  calib::write_image_atomically(kSource / "docs/solid_scan_vs_closed.png", picture);
+  calib::write_image_atomically(kSource / "docs/solid_scan_vs_closed.png",
+                                bench::crops_side_by_side({scan, after, truth}, upper, 3));
   fs::remove_all(out);
   std::printf(
       "wrote docs/composite_error_vs_cost.png, docs/composite_before_after_truth.png and "

@@ -238,6 +238,18 @@ void BenchReport::publish(std::size_t expected_entries) const {
                              std::filesystem::copy_options::overwrite_existing);
 }
 
+cv::Mat crops_side_by_side(const std::vector<cv::Mat>& images, const cv::Rect& crop, double scale) {
+  std::vector<cv::Mat> parts;
+  for (const cv::Mat& image : images) {
+    cv::Mat big;
+    cv::resize(image(crop), big, {}, scale, scale, cv::INTER_NEAREST);
+    parts.push_back(big);
+  }
+  cv::Mat picture;
+  cv::hconcat(parts, picture);
+  return picture;
+}
+
 void publish_stacked(const std::vector<BenchReport>& reports, const std::string& docs_png) {
   std::vector<cv::Mat> charts;
   int width = 0;

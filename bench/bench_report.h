@@ -4,6 +4,7 @@
 // JSON and drawn as a PNG chart (bars of time, or time against error).
 #include <filesystem>
 #include <limits>
+#include <opencv2/core.hpp>
 #include <string>
 #include <vector>
 
@@ -48,6 +49,10 @@ struct BenchReport {
 // Charts of the same runs (e.g. one per image region) that the docs show together: saves
 // each into results_dir() and writes them one above the other to docs/<docs_png>.
 void publish_stacked(const std::vector<BenchReport>& reports, const std::string& docs_png);
+
+// The same part `crop` of each image, enlarged `scale` times (nearest pixel, so pixels
+// stay pixels), side by side: the before / after / truth pictures the docs show.
+cv::Mat crops_side_by_side(const std::vector<cv::Mat>& images, const cv::Rect& crop, double scale);
 
 // Where results go: $LUMAR_BENCH_OUT, else bench/results in the source tree.
 std::filesystem::path results_dir();

@@ -88,6 +88,9 @@ Session parse_session(const json& j, const std::string& file) {
       s.radiometry.vignetting_a = finite(v[0], wr + ".vignetting");
       s.radiometry.vignetting_b = finite(v[1], wr + ".vignetting");
     }
+    s.radiometry.shutter_s = finite(get_or<double>(r, "shutter_s", 0.0, wr), wr + ".shutter_s");
+    if (s.radiometry.shutter_s < 0 || s.radiometry.shutter_s > 1)
+      throw InputError(wr + ".shutter_s: must be from 0 (not known) to 1 second");
   }
   if (j.contains("tracker")) {
     const std::string wt = file + ": tracker";
@@ -187,6 +190,7 @@ json session_to_json(const Session& s) {
   j["radiometry"] = {{"response", s.radiometry.response},
                      {"exposure", s.radiometry.exposure},
                      {"vignetting", {s.radiometry.vignetting_a, s.radiometry.vignetting_b}}};
+  if (s.radiometry.shutter_s > 0) j["radiometry"]["shutter_s"] = s.radiometry.shutter_s;
   j["tracker"] = {{"device", s.tracker.device},
                   {"encoding", s.tracker.encoding},
                   {"output_list", s.tracker.output_list},

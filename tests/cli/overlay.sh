@@ -408,6 +408,42 @@ case_regress_hints_and_options() {
   grep -q "^PASS" "$TMP/log" || fail "no PASS line"
 }
 
+case_motion_blur_from_the_session_or_the_flag() {
+  # The sample has no shutter time: no motion blur unless --shutter gives one, which then
+  # draws the figurine again at the shutter's other instants (its time in "motion blur").
+  # A session's shutter_s is the same; a bad one is named.
+  local shutter
+  for shutter in "" "--shutter 0.04" "--shutter 0.04 --without motion-blur"; do
+    # shellcheck disable=SC2086
+    "$LUMAR" overlay --recording "$REC" --max-frames 3 --poses truth $shutter --stats-json "$TMP/stats.json" \
+      >"$TMP/log" 2>&1 || { cat "$TMP/log"; fail "overlay $shutter failed"; }
+    python3 - "$TMP/stats.json" "$shutter" <<'PY' || fail "motion blur with '$shutter'"
+import json, sys
+ms = json.load(open(sys.argv[1]))['stages']['motion blur']
+on = sys.argv[2] == "--shutter 0.04"
+assert (ms > 0) == on, (sys.argv[2], ms)
+PY
+  done
+  cp -r "$REC" "$TMP/rec"
+  python3 - "$TMP/rec/session.json" <<'PY'
+import json, sys
+s = json.load(open(sys.argv[1])); s['radiometry']['shutter_s'] = 0.04; json.dump(s, open(sys.argv[1], 'w'))
+PY
+  "$LUMAR" overlay --recording "$TMP/rec" --scene "$SRC/data/scenes/room/scene.json" --max-frames 2 --poses truth \
+    --stats-json "$TMP/stats.json" >"$TMP/log" 2>&1 || { cat "$TMP/log"; fail "overlay with the session's shutter failed"; }
+  python3 -c "import json; assert json.load(open('$TMP/stats.json'))['stages']['motion blur'] > 0" ||
+    fail "the session's shutter_s gave no motion blur"
+  python3 - "$TMP/rec/session.json" <<'PY'
+import json, sys
+s = json.load(open(sys.argv[1])); s['radiometry']['shutter_s'] = -0.04; json.dump(s, open(sys.argv[1], 'w'))
+PY
+  expect_bad_input "shutter_s" "$TMP/bad" -- "$LUMAR" overlay --recording "$TMP/rec" \
+    --scene "$SRC/data/scenes/room/scene.json" --frames-dir "$TMP/bad"
+  expect_bad_input "--shutter-instants" "$TMP/bad" -- "$LUMAR" overlay --recording "$REC" --shutter-instants 1 \
+    --frames-dir "$TMP/bad"
+  expect_bad_input "--shutter" "$TMP/bad" -- "$LUMAR" overlay --recording "$REC" --shutter 2 --frames-dir "$TMP/bad"
+}
+
 case_help_describes_every_option() {
   "$LUMAR" --help >"$TMP/h" || fail "lumar --help failed"
   for cmd in synth overlay regress calibrate; do

@@ -2,10 +2,12 @@
 // an analytic expectation and switched off: the sensor's noise statistics, the coverage
 // that antialiasing gives a disc's outline, the Gaussian profile of a blurred edge, and the
 // self-occlusion's open share and bent normal, and the exact lights the object blocks
-// itself, against the CPU's IrradianceVolume::evaluate.
+// itself, against the CPU's IrradianceVolume::evaluate; the motion blur against the
+// frames drawn one instant at a time.
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <glm/gtc/matrix_transform.hpp>
 #include <numbers>
 
 #include "lumar/base/constants.h"
@@ -18,7 +20,7 @@
 namespace lumar::test {
 namespace {
 
-constexpr gl::CompositeFeatures kNone{false, false, false, false};
+constexpr gl::CompositeFeatures kNone{false, false, false, false, false, false, false, false};
 
 // A camera looking down -z at a quad of `half` half-width at z = -2, lit to linear `value`.
 struct FlatObject {
@@ -189,6 +191,71 @@ TEST(CompositeFeatures, TheObjectsOwnShadowDarkensTheExactLightsAtTheNormal) {
   flat.renderer->set_features(kNone);
   EXPECT_NEAR(centre_value(), expected(n, 1.0, 1.0), 0.01f * expected(n, 1.0, 1.0) + 0.002f);
   EXPECT_THROW(flat.renderer->set_object_lights_blocked(flat.id, std::vector<float>(3)), InputError);
+}
+
+TEST(CompositeFeatures, MotionBlurIsTheMeanOfTheShuttersInstants) {
+  headless_context();
+  FlatObject flat(0.5f, 0.5f, {0.002f, 0.0f, -2.0f});  // its edges 0.15 px off the pixels' centres
+  const cv::Mat black(120, 160, CV_8UC3, cv::Scalar::all(0));
+  // Four instants, the quad 8 px to the right (75 px per metre at 2 m) over the shutter.
+  const double travel = 8.0 / 75.0;
+  std::vector<gl::ShutterInstant> moving_object, moving_camera;
+  std::vector<double> offsets;
+  for (int i = 0; i < 4; ++i) {
+    offsets.push_back(((i + 0.5) / 4.0 - 0.5) * travel);
+    moving_object.push_back({flat.pose, {glm::translate(glm::dmat4(1.0), glm::dvec3(offsets.back(), 0, 0))}});
+    // The camera moving the other way instead: the same motion in the image.
+    moving_camera.push_back({look_at({-offsets.back(), 0, 0}, {-offsets.back(), 0, -1}), {glm::dmat4(1.0)}});
+  }
+  const auto row = [](const cv::Mat& bgr8) { return linear_of(bgr8).row(60).clone(); };
+  const auto partly_covered = [](const cv::Mat& linear_row) {
+    int n = 0;
+    for (int c = 0; c < linear_row.cols; ++c) n += linear_row.at<cv::Vec3f>(0, c)[1] > 0.02f && linear_row.at<cv::Vec3f>(0, c)[1] < 0.48f;
+    return n;
+  };
+
+  // Without antialiasing each instant covers whole pixels, so the blurred edge is a ramp
+  // of quarters, three steps two pixels wide at each side.
+  flat.renderer->set_features({.antialiasing = false, .self_occlusion = false, .noise = false, .blur = false});
+  const cv::Mat sharp = flat.renderer->render_overlay(black, flat.pose, 1.0);
+  const cv::Mat blurred = row(flat.renderer->render_overlay(black, flat.pose, 1.0, nullptr, moving_object));
+  cv::Mat reference = cv::Mat::zeros(1, 160, CV_32FC3);
+  for (const double x : offsets) {
+    flat.renderer->set_object_pose(flat.id, glm::translate(glm::dmat4(1.0), glm::dvec3(x, 0, 0)));
+    reference += row(flat.renderer->render_overlay(black, flat.pose, 1.0)) / 4.0;
+  }
+  flat.renderer->set_object_pose(flat.id, glm::dmat4(1.0));
+  const double worst = cv::norm(blurred, reference, cv::NORM_INF);
+  std::printf("motion blur over 8 px: %d partly covered pixels (12 expected), worst |blurred - mean of instants| %.4f\n",
+              partly_covered(blurred), worst);
+  EXPECT_LT(worst, 0.004) << "the mean of the frames drawn at each instant";
+  EXPECT_EQ(partly_covered(blurred), 12);
+  EXPECT_EQ(partly_covered(row(sharp)), 0);
+  EXPECT_NEAR(cv::sum(blurred)[1], cv::sum(row(sharp))[1], 0.01 * cv::sum(row(sharp))[1]) << "light is conserved";
+  const cv::Mat camera_moved = row(flat.renderer->render_overlay(black, flat.pose, 1.0, nullptr, moving_camera));
+  EXPECT_LT(cv::norm(camera_moved, blurred, cv::NORM_INF), 0.004) << "only the motion relative to the camera counts";
+  EXPECT_EQ(cv::norm(flat.renderer->render_overlay(black, flat.pose, 1.0), sharp, cv::NORM_INF), 0.0)
+      << "the poses set stay as they were";
+
+  // Antialiased, the same light, and the ramp as before.
+  flat.renderer->set_features({.antialiasing = true, .self_occlusion = false, .noise = false, .blur = false});
+  const cv::Mat smooth = row(flat.renderer->render_overlay(black, flat.pose, 1.0, nullptr, moving_object));
+  EXPECT_NEAR(cv::sum(smooth)[1], cv::sum(row(sharp))[1], 0.01 * cv::sum(row(sharp))[1]);
+  EXPECT_GE(partly_covered(smooth), 12);
+
+  // Switched off, or one instant: drawn once.
+  flat.renderer->set_features(kNone);
+  EXPECT_EQ(cv::norm(flat.renderer->render_overlay(black, flat.pose, 1.0, nullptr, moving_object), sharp,
+                     cv::NORM_INF),
+            0.0);
+  flat.renderer->set_features({.antialiasing = false, .self_occlusion = false, .noise = false, .blur = false});
+  EXPECT_EQ(cv::norm(flat.renderer->render_overlay(black, flat.pose, 1.0, nullptr,
+                                                   std::span(moving_object).first(1)),
+                     flat.renderer->render_overlay(black, flat.pose, 1.0), cv::NORM_INF),
+            0.0);
+  std::vector<gl::ShutterInstant> wrong = moving_object;
+  wrong[2].T_world_model.clear();
+  EXPECT_THROW(flat.renderer->render_overlay(black, flat.pose, 1.0, nullptr, wrong), InputError);
 }
 
 }  // namespace

@@ -4,6 +4,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdlib>
 
@@ -105,6 +106,13 @@ Overlay::Overlay(std::shared_ptr<const LoadedScene> scene, const CameraIntrinsic
   noise_known_ = !settings.features.noise;
   blur_known_ = !settings.features.blur;
   if (settings.blur_sigma_px >= 0) radiometry_.blur_sigma_px = settings.blur_sigma_px, blur_known_ = true;
+  shutter_s_ = settings.shutter_s.value_or(radiometry.shutter_s);
+  if (!(shutter_s_ >= 0.0 && shutter_s_ <= 1.0))
+    throw InputError(fmt::format("overlay: a shutter time of {} s; use 0 (no motion blur) to 1 s", shutter_s_));
+  shutter_instants_ = settings.shutter_instants;
+  if (shutter_instants_ < OverlaySettings::kMinShutterInstants || shutter_instants_ > OverlaySettings::kMaxShutterInstants)
+    throw InputError(fmt::format("overlay: {} shutter instants; use {} to {}", shutter_instants_,
+                                 OverlaySettings::kMinShutterInstants, OverlaySettings::kMaxShutterInstants));
   compositor_->set_features(settings.features);
   compositor_->set_object_shading(quality_.shading);
   compositor_->set_shadow_quality(quality_.shadows);
@@ -209,9 +217,22 @@ OverlayQuality Overlay::quality() const {
 
 void Overlay::play_paths(Nanos frame_time) { move_along_paths(frame_time, true); }
 
+double Overlay::path_seconds(Nanos frame_time) const {
+  return nanos_to_seconds(live_ ? frame_time - first_frame_time_.value_or(frame_time) : frame_time);
+}
+
+std::vector<Nanos> Overlay::shutter_times(Nanos frame_time) const {
+  if (!(shutter_s_ > 0.0) || !compositor_->renderer().features().motion_blur) return {};
+  // Each instant in the middle of its share of the shutter, as the synthetic camera's.
+  std::vector<Nanos> out;
+  for (int i = 0; i < shutter_instants_; ++i)
+    out.push_back(frame_time + seconds_to_nanos(((i + 0.5) / shutter_instants_ - 0.5) * shutter_s_));
+  return out;
+}
+
 void Overlay::move_along_paths(Nanos frame_time, bool renderer_too) {
   if (!first_frame_time_) first_frame_time_ = frame_time;
-  const double t_s = nanos_to_seconds(live_ ? frame_time - *first_frame_time_ : frame_time);
+  const double t_s = path_seconds(frame_time);
   const auto& objects = compositor_->scene().objects;
   for (std::size_t i = 0; i < objects.size(); ++i)
     if (!objects[i].path.empty()) {
@@ -230,9 +251,9 @@ FrameLight Overlay::prepare(Nanos frame_time) {
 }
 
 OverlayFrame Overlay::render(const capture::Frame& frame, const std::optional<Pose>& T_world_camera,
-                             const FrameLight& light) {
+                             const FrameLight& light, std::span<const std::optional<Pose>> shutter_cameras) {
   OverlayFrame out = begin(frame, T_world_camera);
-  draw(out, frame, light);
+  draw(out, frame, light, shutter_cameras);
   return out;
 }
 
@@ -257,7 +278,8 @@ Overlay::~Overlay() {
   context_.reset();
 }
 
-OverlayFrame Overlay::composite(const capture::Frame& frame, const std::optional<Pose>& T_world_camera) {
+OverlayFrame Overlay::composite(const capture::Frame& frame, const std::optional<Pose>& T_world_camera,
+                                std::span<const std::optional<Pose>> shutter_cameras) {
   OverlayFrame out = begin(frame, T_world_camera);
   play_paths(frame.time);
   if (live_lighting_ && T_world_camera) {
@@ -267,14 +289,31 @@ OverlayFrame Overlay::composite(const capture::Frame& frame, const std::optional
     out.lighting_settled = !live_lighting_->transition();
     times_.lighting += ms_since(t0);
   }
-  draw(out, frame, compositor_->prepare());
+  draw(out, frame, compositor_->prepare(), shutter_cameras);
   return out;
 }
 
-void Overlay::draw(OverlayFrame& out, const capture::Frame& frame, const FrameLight& light) {
+void Overlay::draw(OverlayFrame& out, const capture::Frame& frame, const FrameLight& light,
+                   std::span<const std::optional<Pose>> shutter_cameras) {
   const std::optional<Pose>& T_world_camera = out.T_world_camera;
+  // The shutter's instants: the camera as given, the animated objects where their paths
+  // are then, the others where this frame has them.
+  std::vector<gl::ShutterInstant> shutter;
+  const std::vector<Nanos> times = shutter_times(frame.time);
+  if (T_world_camera && !times.empty() && shutter_cameras.size() == times.size() &&
+      std::all_of(shutter_cameras.begin(), shutter_cameras.end(), [](const auto& c) { return c.has_value(); })) {
+    const auto& objects = compositor_->scene().objects;
+    for (std::size_t k = 0; k < times.size(); ++k) {
+      gl::ShutterInstant& instant = shutter.emplace_back();
+      instant.T_world_camera = *shutter_cameras[k];
+      for (std::size_t i = 0; i < objects.size(); ++i)
+        instant.T_world_model.push_back(objects[i].path.empty() ? light.poses.at(i)
+                                                                : objects[i].pose_at(path_seconds(times[k])));
+    }
+  }
   gl::OverlayTimings gt;
-  out.composite = compositor_->render(light, frame.image, T_world_camera, exposure_ * exposure_scale_, &gt);
+  out.composite =
+      compositor_->render(light, frame.image, T_world_camera, exposure_ * exposure_scale_, &gt, shutter);
   times_.shadows += gt.shadows_ms;
   times_.vertex_light += gt.vertex_light_ms;
   times_.upload += gt.upload_ms;
@@ -282,6 +321,7 @@ void Overlay::draw(OverlayFrame& out, const capture::Frame& frame, const FrameLi
   times_.depth += gt.depth_ms;
   times_.objects += gt.objects_ms;
   times_.antialiasing += gt.antialiasing_ms;
+  times_.motion_blur += gt.motion_blur_ms;
   times_.blur += gt.blur_ms;
   times_.readback += gt.readback_ms;
   if (T_world_camera && ++frames_since_clip_check_ >= kClipCheckEvery) measure_clipping(out.composite, *T_world_camera);
@@ -318,6 +358,7 @@ std::vector<std::pair<std::string, double>> StageTimes::stages() const {
           {"proxy depth", depth},
           {"virtual objects", objects},
           {"antialiasing", antialiasing},
+          {"motion blur", motion_blur},
           {"camera blur", blur},
           {"read back", readback},
           {"encode output", output}};

@@ -98,6 +98,25 @@ std::optional<Pose> ReplayOverlay::camera_pose(const capture::Frame& frame) {
   return fused_ ? fused_->update(frame, tracked) : tracked;
 }
 
+std::vector<std::optional<Pose>> ReplayOverlay::shutter_cameras(const capture::Frame& frame,
+                                                               const std::optional<Pose>& pose) const {
+  const std::vector<Nanos> times = overlay_->shutter_times(frame.time);
+  if (!pose || times.empty()) return {};
+  std::vector<std::optional<Pose>> out;
+  const std::optional<Pose> tracked = replay_.tracked_camera_pose(frame.time);
+  for (const Nanos t : times) {
+    if (t == frame.time) {  // the frame's own pose, bit for bit: the renderer draws that instant once
+      out.push_back(pose);
+    } else if (pose_source_ == PoseSource::Truth) {
+      out.push_back(replay_.true_camera_pose_at(t));
+    } else {
+      const std::optional<Pose> then = replay_.tracked_camera_pose(t);
+      out.push_back(tracked && then ? std::optional<Pose>(*pose * tracked->inverse() * *then) : std::nullopt);
+    }
+  }
+  return out;
+}
+
 void ReplayOverlay::run(int max_frames, const std::function<bool(const OverlayFrame&)>& sink, bool pipelined) {
   if (pipelined) return run_pipelined(max_frames, sink);
   auto frames = replay_.open_frames();
@@ -111,9 +130,10 @@ void ReplayOverlay::run(int max_frames, const std::function<bool(const OverlayFr
 
     t0 = Clock::now();
     const std::optional<Pose> pose = camera_pose(frame);
+    const std::vector<std::optional<Pose>> shutter = shutter_cameras(frame, pose);
     times.pose += ms_since(t0);
 
-    const OverlayFrame out = overlay_->composite(frame, pose);
+    const OverlayFrame out = overlay_->composite(frame, pose, shutter);
     t0 = Clock::now();
     const bool go_on = sink(out);
     times.output += ms_since(t0);
@@ -192,9 +212,10 @@ void ReplayOverlay::run_pipelined(int max_frames, const std::function<bool(const
       times.decode += p.decoded.decode_ms;
       const auto t0 = Clock::now();
       const std::optional<Pose> pose = camera_pose(p.decoded.frame);
+      const std::vector<std::optional<Pose>> shutter = shutter_cameras(p.decoded.frame, pose);
       times.pose += ms_since(t0);
-      OverlayFrame out =
-          p.light ? overlay_->render(p.decoded.frame, pose, *p.light) : overlay_->composite(p.decoded.frame, pose);
+      OverlayFrame out = p.light ? overlay_->render(p.decoded.frame, pose, *p.light, shutter)
+                                 : overlay_->composite(p.decoded.frame, pose, shutter);
       if (!composited.push(Composited{std::move(out), p.decoded.start})) break;
     }
   } catch (...) {

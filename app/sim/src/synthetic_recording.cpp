@@ -313,6 +313,7 @@ void synthesize_recording(const SynthSettings& s) {
   session.radiometry.exposure = exposure;
   session.radiometry.vignetting_a = s.vignetting_a;
   session.radiometry.vignetting_b = s.vignetting_b;
+  session.radiometry.shutter_s = s.faults.motion_blur_s;
 
   // The truth: the room's light on the objects physically present, by brute force, from
   // a map of 128 rows (its bright texels summed exactly, the rest by rays).
@@ -353,16 +354,22 @@ void synthesize_recording(const SynthSettings& s) {
           if (w != shown_weight) renderer.set_environment(blend_environment_maps(scene.map, *changed_map, w));
           shown_weight = w;
         }
-        cv::Mat radiance = renderer.render_room_radiance(pinhole, T_world_camera);
-        if (s.faults.motion_blur_s > 0) {  // the shutter open around t
-          radiance /= double(VideoFaults::kBlurSamples);
+        // The shutter open around t: the camera and the room at each instant (t's first).
+        struct Instant {
+          Nanos t;
+          Pose T_world_camera;
+          cv::Mat radiance;
+        };
+        std::vector<Instant> shutter{{t, T_world_camera, renderer.render_room_radiance(pinhole, T_world_camera)}};
+        if (s.faults.motion_blur_s > 0)
           for (int i = 0; i < VideoFaults::kBlurSamples; ++i) {
-            if (2 * i + 1 == VideoFaults::kBlurSamples) continue;  // the middle one is above
+            if (2 * i + 1 == VideoFaults::kBlurSamples) continue;  // the middle one is t's
             const double at = ((i + 0.5) / VideoFaults::kBlurSamples - 0.5) * s.faults.motion_blur_s;
-            radiance += renderer.render_room_radiance(pinhole, true_camera(t + seconds_to_nanos(at))) /
-                        double(VideoFaults::kBlurSamples);
+            const Pose camera = true_camera(t + seconds_to_nanos(at));
+            shutter.push_back({t + seconds_to_nanos(at), camera, renderer.render_room_radiance(pinhole, camera)});
           }
-        }
+        cv::Mat radiance = shutter[0].radiance / double(shutter.size());
+        for (std::size_t i = 1; i < shutter.size(); ++i) radiance += shutter[i].radiance / double(shutter.size());
         apply_video_faults(s.faults, k, occluder, radiance);
         // The video's own noise, drawn again for the truth, so that only the objects differ.
         cv::RNG same_noise = rng;
@@ -371,13 +378,28 @@ void synthesize_recording(const SynthSettings& s) {
             truth && (s.truth_frames.empty() ||
                       std::find(s.truth_frames.begin(), s.truth_frames.end(), k) != s.truth_frames.end());
         if (truth_here) {
-          if (animated) {  // the objects where their paths are at this frame
-            std::vector<LoadedObject> posed = scene.objects;
-            for (LoadedObject& o : posed) o.T_world_model = o.pose_at(nanos_to_seconds(t));
-            truth = std::make_unique<CompositeReference>(*truth_room, posed, truth_reference);
+          // The objects seen at each instant of the shutter, averaged as the video's room
+          // is: a moving object's truth is blurred by its motion and the camera's.
+          if (shutter.size() == 1) shutter[0].radiance = radiance;  // with the faults
+          TruthFrame frame;
+          for (Instant& instant : shutter) {
+            if (shutter.size() > 1) apply_video_faults(s.faults, k, occluder, instant.radiance);
+            if (animated) {  // the objects where their paths are at this instant
+              std::vector<LoadedObject> posed = scene.objects;
+              for (LoadedObject& o : posed) o.T_world_model = o.pose_at(nanos_to_seconds(instant.t));
+              truth = std::make_unique<CompositeReference>(*truth_room, posed, truth_reference);
+            }
+            const TruthFrame seen_then = render_truth_frame(*truth, *room_surfaces, pinhole, instant.T_world_camera,
+                                                            instant.radiance, truth_settings);
+            const double w = 1.0 / double(shutter.size());
+            if (frame.radiance.empty()) {
+              frame.radiance = seen_then.radiance * w;
+              frame.coverage = seen_then.coverage * w;
+            } else {
+              frame.radiance += seen_then.radiance * w;
+              frame.coverage += seen_then.coverage * w;
+            }
           }
-          const TruthFrame frame =
-              render_truth_frame(*truth, *room_surfaces, pinhole, T_world_camera, radiance, truth_settings);
           const cv::Mat seen = calib::distort_image(frame.radiance, pinhole, s.camera);
           const std::filesystem::path dir = s.out / "truth";
           std::filesystem::create_directories(dir);

@@ -476,6 +476,9 @@ class OverlayUi {
     dirty_ |= ImGui::Checkbox("bounce (objects light the room)", &features_.bounce);
     ImGui::SameLine();
     dirty_ |= ImGui::Checkbox("contact shadows", &features_.contact);
+    if (overlay_.shutter_s() > 0)  // the recording says how long its shutter was open
+      dirty_ |= ImGui::Checkbox(fmt::format("motion blur ({:.0f} ms shutter)", 1e3 * overlay_.shutter_s()).c_str(),
+                                &features_.motion_blur);
     float exposure = float(overlay_.exposure_scale());
     if (ImGui::SliderFloat("exposure", &exposure, 0.25f, 4.0f, "%.2fx", ImGuiSliderFlags_Logarithmic))
       overlay_.set_exposure_scale(exposure), dirty_ = true;

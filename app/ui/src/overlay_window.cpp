@@ -85,7 +85,8 @@ class ReplayWindow {
     ui_.set_dirty(false);
     ui_.apply_switches();
     const pipeline::StageTimes before = overlay_.times();
-    const pipeline::OverlayFrame out = overlay_.composite(frame_, replay_.camera_pose(frame_));
+    const std::optional<Pose> pose = replay_.camera_pose(frame_);
+    const pipeline::OverlayFrame out = overlay_.composite(frame_, pose, replay_.shutter_cameras(frame_, pose));
     ui_.show(out, before);
     if (overlay_.compositor().settling()) ui_.set_dirty(true);  // paused: the contact shadows still to come
     // The first time the window reaches a frame in order (played, or stepped to): outputs,

@@ -437,7 +437,8 @@ void Compositor::forget_prepared() {
 }
 
 cv::Mat Compositor::render(const FrameLight& light, const cv::Mat& video_bgr8,
-                           const std::optional<Pose>& T_world_camera, double exposure, gl::OverlayTimings* timings) {
+                           const std::optional<Pose>& T_world_camera, double exposure, gl::OverlayTimings* timings,
+                           std::span<const gl::ShutterInstant> shutter) {
   for (std::size_t i = 0; i < light.poses.size(); ++i) renderer_->set_object_pose(int(i), light.poses[i]);
   if (light.receiver_attenuation) renderer_->set_receiver_attenuation(*light.receiver_attenuation);
   if (light.contact) renderer_->set_contact_receivers(light.contact->receivers, light.contact->correction);
@@ -454,7 +455,7 @@ cv::Mat Compositor::render(const FrameLight& light, const cv::Mat& video_bgr8,
     timings->shadows_ms = light.shadows_ms;
     timings->vertex_light_ms = light.vertex_light_ms;
   }
-  return renderer_->render_overlay(video_bgr8, T_world_camera, exposure, timings);
+  return renderer_->render_overlay(video_bgr8, T_world_camera, exposure, timings, shutter);
 }
 
 }  // namespace lumar

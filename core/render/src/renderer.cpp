@@ -146,10 +146,13 @@ struct Renderer::Impl {
 
   // The pixels the objects may cover (their boxes projected, 2 px more), clipped to the
   // image; the whole image when a box reaches behind the camera.
-  cv::Rect objects_footprint(const glm::mat4& vp) const {
+  // `which`: only the objects it marks (nullptr: all).
+  cv::Rect objects_footprint(const glm::mat4& vp, const std::vector<char>* which = nullptr) const {
     const cv::Rect image(0, 0, camera.width, camera.height);
     float x0 = 1e30f, y0 = 1e30f, x1 = -1e30f, y1 = -1e30f;
-    for (const Object& o : objects)
+    for (std::size_t i = 0; i < objects.size(); ++i) {
+      if (which && !(*which)[i]) continue;
+      const Object& o = objects[i];
       for (int k = 0; k < 8; ++k) {
         const glm::vec3 corner((k & 1) ? o.hi.x : o.lo.x, (k & 2) ? o.hi.y : o.lo.y, (k & 4) ? o.hi.z : o.lo.z);
         const glm::vec4 clip = vp * o.model * glm::vec4(corner, 1.0f);
@@ -158,6 +161,7 @@ struct Renderer::Impl {
         const float y = (clip.y / clip.w * 0.5f + 0.5f) * float(camera.height);  // GL rows, bottom up
         x0 = std::min(x0, x), x1 = std::max(x1, x), y0 = std::min(y0, y), y1 = std::max(y1, y);
       }
+    }
     if (x1 < x0) return {};
     const cv::Rect box(cv::Point(int(std::floor(x0)) - 2, int(std::floor(y0)) - 2),
                        cv::Point(int(std::ceil(x1)) + 3, int(std::ceil(y1)) + 3));
@@ -166,7 +170,8 @@ struct Renderer::Impl {
 
   CameraIntrinsics camera;
   GlName empty_vertex_array;  // core profile needs one bound even for attribute-less draws
-  GlName background, depth_only, shaded_object, world_position, room_radiance, encode, blur, covered, antialias_resolve;
+  GlName background, depth_only, shaded_object, world_position, room_radiance, encode, blur, covered, antialias_resolve,
+      weighted_copy;
   GpuMesh room;
   std::unique_ptr<ShadowPass> receivers;  // shadow receivers, drawn over the video
   std::unique_ptr<ShadowPass> contact;    // dense receivers where objects touch them, drawn after
@@ -195,6 +200,7 @@ struct Renderer::Impl {
   MultisampleTarget multisampled;      // the objects' coverage, 4 samples per pixel
   RenderTarget coverage;               // its resolve (R8)
   RenderTarget scratch, scratch_rows;  // a copy of part of `scene`, the blur's rows (RGBA32F)
+  RenderTarget still, accumulated;     // motion blur: the background kept, the instants' sum (RGBA32F)
   RenderTarget encoded;                // sRGB 8-bit, output size, rows flipped for read-back
   RenderTarget room_target;            // for render_room_radiance, resized on demand
 
@@ -354,6 +360,132 @@ struct Renderer::Impl {
     glDisable(GL_SCISSOR_TEST);
   }
 
+  // At one camera pose and the objects' poses: the proxy's depth and the receivers'
+  // shadows over the video in `scene`, then the objects, each pixel shaded once.
+  void draw_depth_and_shadows(const glm::mat4& vp) {
+    glEnable(GL_DEPTH_TEST);
+    glDepthFunc(GL_LESS);
+    glDepthMask(GL_TRUE);
+    draw_room_depth(vp);
+    if (receivers) receivers->draw(vp);  // shadows on the video, before the objects
+    if (receivers && contact) contact->draw(vp);
+  }
+  void draw_shaded_objects(const glm::mat4& vp, float exposure) {
+    // Depth first, then shade only the nearest surface: the per-pixel lighting is the
+    // costly part, and a figurine's own overlapping parts would otherwise pay it twice.
+    glColorMask(GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
+    draw_objects(depth_only.get(), vp, false, 0.0f);
+    glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+    glDepthFunc(GL_LEQUAL);
+    glDepthMask(GL_FALSE);
+    draw_objects(shaded_object.get(), vp, true, exposure);
+    glDepthMask(GL_TRUE);
+    glDepthFunc(GL_LESS);
+    glDisable(GL_DEPTH_TEST);
+  }
+
+  void pose_objects(const std::vector<glm::dmat4>& T_world_model) {
+    for (std::size_t i = 0; i < objects.size(); ++i) {
+      objects[i].model = glm::mat4(T_world_model[i]);
+      objects[i].normal_matrix = glm::mat3(glm::transpose(glm::inverse(glm::dmat3(T_world_model[i]))));
+    }
+  }
+  // The objects' poses as set, to put back after drawing them elsewhere.
+  using KeptPoses = std::vector<std::pair<glm::mat4, glm::mat3>>;
+  KeptPoses keep_poses() const {
+    KeptPoses kept;
+    for (const Object& o : objects) kept.emplace_back(o.model, o.normal_matrix);
+    return kept;
+  }
+  void put_back(const KeptPoses& kept) {
+    for (std::size_t i = 0; i < objects.size(); ++i) std::tie(objects[i].model, objects[i].normal_matrix) = kept[i];
+  }
+  static cv::Rect bounding(const cv::Rect& a, const cv::Rect& b) { return a.empty() ? b : (b.empty() ? a : (a | b)); }
+
+  // Where the objects that move against the camera during the shutter are at any of its
+  // instants (their footprints' bounding box): the only pixels the instants draw
+  // differently. An object still in the camera's view adds nothing.
+  cv::Rect shutter_footprint(std::span<const ShutterInstant> shutter) {
+    std::vector<char> moving(objects.size(), 0);
+    const glm::dmat4 first_view = glm::inverse(shutter[0].T_world_camera.matrix());
+    for (std::size_t i = 0; i < objects.size(); ++i)
+      for (const ShutterInstant& instant : shutter) {
+        const glm::dmat4 change = glm::inverse(instant.T_world_camera.matrix()) * instant.T_world_model[i] -
+                                  first_view * shutter[0].T_world_model[i];
+        for (int c = 0; c < 4; ++c) moving[i] |= glm::length(change[c]) > 1e-9;
+      }
+    const KeptPoses kept = keep_poses();
+    cv::Rect box;
+    for (const ShutterInstant& instant : shutter) {
+      pose_objects(instant.T_world_model);
+      box = bounding(box, objects_footprint(view_projection(camera, instant.T_world_camera), &moving));
+    }
+    put_back(kept);
+    return box;
+  }
+
+  void make_motion_targets() {
+    if (still.width == camera.width && still.height == camera.height) return;
+    still = RenderTarget(camera.width, camera.height, GL_RGBA32F, false, "the background kept");
+    accumulated = RenderTarget(camera.width, camera.height, GL_RGBA32F, false, "the shutter's sum");
+  }
+
+  // Motion blur, within `box` of `scene`: the mean of the frame drawn at each instant of
+  // the shutter over the background `still` holds there (an accumulation buffer; Haeberli
+  // & Akeley 1990). Each instant costs one more drawing of the objects, antialiased as
+  // the frame is; `scene` holds the frame drawn once at the poses set, and the instant
+  // that is that frame is taken from it, not drawn again.
+  void blur_motion(std::span<const ShutterInstant> shutter, const cv::Rect& box, const Pose& T_world_camera,
+                   float exposure, bool antialiasing) {
+    const KeptPoses kept = keep_poses();
+    const auto is_drawn_frame = [&](const ShutterInstant& instant) {
+      if (instant.T_world_camera.rotation != T_world_camera.rotation ||
+          instant.T_world_camera.translation != T_world_camera.translation)
+        return false;
+      for (std::size_t i = 0; i < objects.size(); ++i)
+        if (glm::mat4(instant.T_world_model[i]) != kept[i].first) return false;
+      return true;
+    };
+    const float weight = 1.0f / float(shutter.size());
+    const auto add_to_sum = [&] {
+      begin_within(accumulated, box);
+      glEnable(GL_BLEND);
+      glBlendFunc(GL_ONE, GL_ONE);
+      glUseProgram(weighted_copy.get());
+      glProgramUniform1f(weighted_copy.get(), uniform(weighted_copy.get(), "weight"), weight);
+      glBindTextureUnit(shaders::kLinearImageUnit, scene.color.get());
+      draw_fullscreen();
+      glDisable(GL_BLEND);
+      glDisable(GL_SCISSOR_TEST);
+    };
+    begin_within(accumulated, box);
+    const float zero[4] = {0, 0, 0, 0}, far = 1.0f;
+    glClearNamedFramebufferfv(accumulated.framebuffer.get(), GL_COLOR, 0, zero);
+    glDisable(GL_SCISSOR_TEST);
+    std::vector<char> drawn(shutter.size(), 0);
+    for (std::size_t k = 0; k < shutter.size(); ++k)
+      if (is_drawn_frame(shutter[k])) {
+        add_to_sum();
+        drawn[k] = 1;
+        break;
+      }
+    for (std::size_t k = 0; k < shutter.size(); ++k) {
+      if (drawn[k]) continue;
+      pose_objects(shutter[k].T_world_model);
+      const glm::mat4 vp = view_projection(camera, shutter[k].T_world_camera);
+      copy_within(still.framebuffer.get(), scene, box);
+      begin_within(scene, box);
+      glClearNamedFramebufferfv(scene.framebuffer.get(), GL_DEPTH, 0, &far);
+      draw_depth_and_shadows(vp);
+      draw_shaded_objects(vp, exposure);
+      glDisable(GL_SCISSOR_TEST);
+      if (antialiasing) antialias(vp, objects_footprint(vp) & box, shutter[k].T_world_camera);
+      add_to_sum();
+    }
+    copy_within(accumulated.framebuffer.get(), scene, box);
+    put_back(kept);
+  }
+
   // Visible object positions after proxy occlusion, into `scene`; RGBA32F, row 0 at the bottom.
   void draw_positions(const Pose& T_world_camera) {
     const glm::mat4 vp = view_projection(camera, T_world_camera);
@@ -387,6 +519,7 @@ Renderer::Renderer(const CameraIntrinsics& camera) : impl_(std::make_unique<Impl
   r.blur = create_program("camera blur", kFullscreenVertex, kBlurFragment);
   r.covered = create_program("object coverage", kMeshVertex, kCoveredFragment);
   r.antialias_resolve = create_program("antialiasing", kFullscreenVertex, kAntialiasFragment);
+  r.weighted_copy = create_program("motion blur sum", kFullscreenVertex, kWeightedCopyFragment);
   r.scene = RenderTarget(camera.width, camera.height, GL_RGBA32F, true, "the linear scene");
   r.encoded = RenderTarget(camera.width, camera.height, GL_RGBA8, false, "the encoded output");
   GLint max_samples = 0;
@@ -604,10 +737,14 @@ void Renderer::set_video_radiometry(const VideoRadiometry& radiometry) {
 }
 
 cv::Mat Renderer::render_overlay(const cv::Mat& video_bgr8, const std::optional<Pose>& T_world_camera, double exposure,
-                                 OverlayTimings* timings) {
+                                 OverlayTimings* timings, std::span<const ShutterInstant> shutter) {
   if (video_bgr8.type() != CV_8UC3 || video_bgr8.empty())
     throw InputError("Renderer::render_overlay: video frame must be non-empty BGR8 (CV_8UC3); convert it first");
   Impl& r = *impl_;
+  for (const ShutterInstant& instant : shutter)
+    if (instant.T_world_model.size() != r.objects.size())
+      throw InputError("Renderer::render_overlay: a shutter instant has " + std::to_string(instant.T_world_model.size()) +
+                       " object poses for " + std::to_string(r.objects.size()) + " objects");
   OverlayTimings t;
   if (timings) {  // the compositor's, before this call
     t.shadows_ms = timings->shadows_ms;
@@ -633,44 +770,39 @@ cv::Mat Renderer::render_overlay(const cv::Mat& video_bgr8, const std::optional<
   r.draw_fullscreen();
   clock.mark(&t.background_ms);
 
+  // Motion blur draws the objects again at each instant, over the background kept here.
+  const bool motion_blur = T_world_camera && r.features.motion_blur && shutter.size() >= 2;
+  const cv::Rect moving = motion_blur ? r.shutter_footprint(shutter) : cv::Rect();
+  if (!moving.empty()) {
+    r.make_motion_targets();
+    Impl::copy_within(r.scene.framebuffer.get(), r.still, moving);
+  }
+
   // Without a pose there is nothing to place: the video alone, never a guessed object.
   if (T_world_camera) {
     const glm::mat4 vp = Impl::view_projection(r.camera, *T_world_camera);
-    glEnable(GL_DEPTH_TEST);
-    glDepthFunc(GL_LESS);
-    glDepthMask(GL_TRUE);
-    r.draw_room_depth(vp);
-    if (r.receivers) r.receivers->draw(vp);  // shadows on the video, before the objects
-    if (r.receivers && r.contact) r.contact->draw(vp);
+    r.draw_depth_and_shadows(vp);
     clock.mark(&t.depth_ms);
-
-    // Depth first, then shade only the nearest surface: the per-pixel lighting is the
-    // costly part, and a figurine's own overlapping parts would otherwise pay it twice.
-    glColorMask(GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
-    r.draw_objects(r.depth_only.get(), vp, false, 0.0f);
-    glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
-    glDepthFunc(GL_LEQUAL);
-    glDepthMask(GL_FALSE);
-    r.draw_objects(r.shaded_object.get(), vp, true, float(exposure));
-    glDepthMask(GL_TRUE);
-    glDepthFunc(GL_LESS);
-    glDisable(GL_DEPTH_TEST);
+    r.draw_shaded_objects(vp, float(exposure));
     clock.mark(&t.objects_ms);
   }
   // Antialiasing and blur change `scene` in place, only within the objects' footprint.
   const bool antialiasing = r.features.antialiasing && r.multisampled.samples > 1;
   const bool blur = r.features.blur && r.blur_sigma > 0.0f;
-  if (T_world_camera && (antialiasing || blur)) {
+  if (T_world_camera && antialiasing) {
+    const glm::mat4 vp = Impl::view_projection(r.camera, *T_world_camera);
+    r.antialias(vp, r.objects_footprint(vp), *T_world_camera);
+    clock.mark(&t.antialiasing_ms);
+  }
+  if (!moving.empty()) {
+    r.blur_motion(shutter, moving, *T_world_camera, float(exposure), antialiasing);
+    clock.mark(&t.motion_blur_ms);
+  }
+  if (T_world_camera && blur) {
     const glm::mat4 vp = Impl::view_projection(r.camera, *T_world_camera);
     const cv::Rect footprint = r.objects_footprint(vp);
-    if (antialiasing) {
-      r.antialias(vp, footprint, *T_world_camera);
-      clock.mark(&t.antialiasing_ms);
-    }
-    if (blur) {
-      r.blur_rendered(footprint);
-      clock.mark(&t.blur_ms);
-    }
+    r.blur_rendered(Impl::bounding(footprint, moving));
+    clock.mark(&t.blur_ms);
   }
 
   // Encode to sRGB 8-bit (rows flipped) and read back top row first.

@@ -293,4 +293,12 @@ void main() {
 }
 )glsl";
 
+const char* const kWeightedCopyFragment = R"glsl(
+#version 450 core
+layout(binding = 3) uniform sampler2D linear_image;
+uniform float weight;
+out vec4 color;
+void main() { color = weight * texelFetch(linear_image, ivec2(gl_FragCoord.xy), 0); }
+)glsl";
+
 }  // namespace lumar::gl::shaders

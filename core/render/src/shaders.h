@@ -17,6 +17,7 @@ extern const char* const kEncodeFragment;         // linear -> sRGB, rows flippe
 extern const char* const kBlurFragment;           // one pass of the camera's blur on rendered pixels
 extern const char* const kCoveredFragment;        // 1: where an object is (its coverage, multisampled)
 extern const char* const kAntialiasFragment;      // outline pixels mixed by the objects' coverage
+extern const char* const kWeightedCopyFragment;   // the linear image times a weight (motion blur's sum)
 
 constexpr int kVideoUnit = 0, kUndistortionMapUnit = 1, kEnvironmentUnit = 2, kLinearImageUnit = 3;
 // The camera response as look-up tables (Renderer::set_video_radiometry).

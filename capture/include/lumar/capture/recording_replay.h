@@ -46,6 +46,9 @@ class RecordingReplay {
   std::optional<Pose> tracked_camera_pose(Nanos t) const;
   // True T_world_camera of frame `index`, where the recording has ground truth.
   std::optional<Pose> true_camera_pose(std::int64_t index) const;
+  // True T_world_camera at time t, interpolated between the two truth entries around it
+  // (beyond the first or the last, extrapolated from the two nearest); nullopt without truth.
+  std::optional<Pose> true_camera_pose_at(Nanos t) const;
   // T_transmitter_sensor of the session's station, timed with the rig's latency.
   const tracking::PoseStream& sensor_poses() const { return poses_; }
   const TrackerReplayStats& tracker_stats() const { return stats_; }

@@ -21,6 +21,9 @@ struct Radiometry {
   // Vignetting gain 1 + a r^2 + b r^4, r = distance from the principal point over the
   // half-diagonal. {0, 0} = none.
   double vignetting_a = 0.0, vignetting_b = 0.0;
+  // How long each frame's shutter was open, seconds: what the camera's motion and the
+  // objects' blur over (the overlay's motion blur). 0: not known, no motion blur.
+  double shutter_s = 0.0;
 };
 
 struct TrackerSettings {

@@ -6,6 +6,7 @@
 #include <chrono>
 #include <memory>
 #include <optional>
+#include <span>
 #include <string>
 #include <utility>
 #include <vector>
@@ -61,6 +62,13 @@ struct OverlaySettings {
   // calib/camera_blur.h) unless blur_sigma_px >= 0 gives the blur.
   gl::CompositeFeatures features;
   double blur_sigma_px = -1.0;
+  // Motion blur (features.motion_blur): how long the shutter was open, seconds, instead
+  // of the session's radiometry.shutter_s (0: none), and at how many instants of it the
+  // objects are drawn (kMinShutterInstants to kMaxShutterInstants; each costs one more
+  // drawing of the objects).
+  std::optional<double> shutter_s;
+  int shutter_instants = 3;
+  static constexpr int kMinShutterInstants = 2, kMaxShutterInstants = 16;
   OverlayQuality quality;
   // Animated objects (the manifest's paths) play in recording time; live, from the first
   // frame the overlay sees.
@@ -69,7 +77,7 @@ struct OverlaySettings {
 
 struct StageTimes {  // milliseconds, summed over frames
   double decode = 0, pose = 0, measure = 0, lighting = 0, shadows = 0, vertex_light = 0, upload = 0, background = 0,
-         depth = 0, objects = 0, antialiasing = 0, blur = 0, readback = 0, output = 0;
+         depth = 0, objects = 0, antialiasing = 0, motion_blur = 0, blur = 0, readback = 0, output = 0;
   // From a frame's start (replay: its decode; live: the middle of its exposure) to its
   // composite handed on, summed over frames.
   double latency = 0;
@@ -102,7 +110,15 @@ class Overlay {
 
   // Moves the animated objects to where their paths are at the frame's time, adapts the
   // lighting (with a pose, on every n-th call) and composites the frame.
-  OverlayFrame composite(const capture::Frame& frame, const std::optional<Pose>& T_world_camera);
+  // `shutter_cameras`: the camera's pose at each of shutter_times(frame.time), for the
+  // motion blur; without them, or with one missing, the frame has none.
+  OverlayFrame composite(const capture::Frame& frame, const std::optional<Pose>& T_world_camera,
+                         std::span<const std::optional<Pose>> shutter_cameras = {});
+  // The instants of a frame's shutter at which the motion blur draws the objects, the
+  // shutter centred on the frame's time; empty when the shutter time is 0 or the motion
+  // blur is off.
+  std::vector<Nanos> shutter_times(Nanos frame_time) const;
+  double shutter_s() const { return shutter_s_; }
   // Only the first step of composite(): the animated objects where their paths are then.
   void play_paths(Nanos frame_time);
 
@@ -113,7 +129,8 @@ class Overlay {
   // adaptation changes the light between frames on the GL thread.
   bool can_prepare_ahead() const { return !live_lighting_; }
   FrameLight prepare(Nanos frame_time);
-  OverlayFrame render(const capture::Frame& frame, const std::optional<Pose>& T_world_camera, const FrameLight& light);
+  OverlayFrame render(const capture::Frame& frame, const std::optional<Pose>& T_world_camera, const FrameLight& light,
+                      std::span<const std::optional<Pose>> shutter_cameras = {});
 
   // Swaps in another scene (objects added or removed, another lighting method): a new
   // compositor with this one's features, quality and measured camera; the irradiance
@@ -200,10 +217,14 @@ class Overlay {
   // Where the paths put the animated objects at frame_time: on the compositor and its
   // renderer, or (prepare) on the compositor's CPU side alone.
   void move_along_paths(Nanos frame_time, bool renderer_too);
+  double path_seconds(Nanos frame_time) const;  // where the paths are at a frame's time
+  double shutter_s_ = 0.0;
+  int shutter_instants_ = 3;
   // composite()'s and render()'s common start (the frame's fields, the camera measured)
   // and end (the objects drawn, the times kept).
   OverlayFrame begin(const capture::Frame& frame, const std::optional<Pose>& T_world_camera);
-  void draw(OverlayFrame& out, const capture::Frame& frame, const FrameLight& light);
+  void draw(OverlayFrame& out, const capture::Frame& frame, const FrameLight& light,
+            std::span<const std::optional<Pose>> shutter_cameras);
 };
 
 // One line per stage: mean milliseconds per frame and share of the total.

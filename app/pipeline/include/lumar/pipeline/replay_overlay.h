@@ -55,6 +55,11 @@ class ReplayOverlay {
   // the tracker has nothing for it). Fused poses want the frames in order; any other
   // frame starts the fusion again from the tracker.
   std::optional<Pose> camera_pose(const capture::Frame& frame);
+  // The camera at each instant of the frame's shutter (Overlay::shutter_times; empty
+  // without motion blur or without `pose`, the frame's camera_pose): the truth
+  // interpolated between its frames, or the tracker's motion from the frame's time to the
+  // instant's applied to `pose`.
+  std::vector<std::optional<Pose>> shutter_cameras(const capture::Frame& frame, const std::optional<Pose>& pose) const;
   PoseSource pose_source() const { return pose_source_; }
   // Truth: InputError when the recording has none. Fused without a proxy room in the
   // scene: the tracker's, with a warning.

@@ -76,7 +76,8 @@ class Compositor {
 
   // Composites one BGR8 video frame seen from T_world_camera (nullopt: no pose, the
   // undistorted video alone); `exposure` is the video's linear value per unit of scene radiance.
-  // It is render(prepare(), ...).
+  // It is render(prepare(), ...). `shutter`: the camera and the objects at instants of
+  // the shutter, for their motion blur (gl::Renderer::render_overlay).
   cv::Mat composite(const cv::Mat& video_bgr8, const std::optional<Pose>& T_world_camera, double exposure,
                     gl::OverlayTimings* timings = nullptr);
   // The two halves of composite(). prepare() touches no GL and may run on another thread
@@ -84,7 +85,8 @@ class Compositor {
   // meanwhile; the frames must be rendered in the order they were prepared.
   FrameLight prepare();
   cv::Mat render(const FrameLight& light, const cv::Mat& video_bgr8, const std::optional<Pose>& T_world_camera,
-                 double exposure, gl::OverlayTimings* timings = nullptr);
+                 double exposure, gl::OverlayTimings* timings = nullptr,
+                 std::span<const gl::ShutterInstant> shutter = {});
   // Frames were prepared and never rendered (a pipelined run stopped): the next prepare()
   // hands on everything again, not only what changed since.
   void forget_prepared();

@@ -32,8 +32,8 @@ namespace lumar::gl {
 struct OverlayTimings {
   double shadows_ms = 0;       // the compositor's: moved objects' shadows traced again (shadow lines)
   double vertex_light_ms = 0;  // the compositor's: moved objects' light per vertex (ObjectShading::PerVertex)
-  double upload_ms = 0, background_ms = 0, depth_ms = 0, objects_ms = 0, antialiasing_ms = 0, blur_ms = 0,
-         readback_ms = 0;
+  double upload_ms = 0, background_ms = 0, depth_ms = 0, objects_ms = 0, antialiasing_ms = 0, motion_blur_ms = 0,
+         blur_ms = 0, readback_ms = 0;
 };
 
 // How the camera turned light into video, so that rendered pixels look like the
@@ -68,6 +68,16 @@ struct CompositeFeatures {
   // With the lines: a dense patch of receivers where an object rests on a receiver
   // surface, for the contact shadow the lines' coarse receivers blur (the Compositor's).
   bool contact = true;
+  // The objects drawn at several instants of the shutter and averaged, when the frame
+  // gives them (render_overlay's `shutter`): their motion blur against the camera.
+  bool motion_blur = true;
+};
+
+// One instant while the camera's shutter was open: where the camera and each object
+// (add_object order) were then.
+struct ShutterInstant {
+  Pose T_world_camera;
+  std::vector<glm::dmat4> T_world_model;
 };
 
 class Renderer {
@@ -151,8 +161,13 @@ class Renderer {
   // (CV_8UC3, the undistortion map's source size); `exposure` is the video's linear
   // value per unit of scene radiance. Without a pose (nullopt) the frame shows the
   // undistorted video alone: no object is drawn where the camera cannot be placed.
+  // `shutter`: with two instants or more and CompositeFeatures::motion_blur, the frame is
+  // drawn at each and the drawings averaged where the objects are at any of them (an
+  // accumulation buffer); elsewhere, and without them, it is drawn once at T_world_camera
+  // with the poses set. The poses set stay as they were. InputError unless each instant
+  // has one pose per object.
   cv::Mat render_overlay(const cv::Mat& video_bgr8, const std::optional<Pose>& T_world_camera, double exposure,
-                         OverlayTimings* timings = nullptr);
+                         OverlayTimings* timings = nullptr, std::span<const ShutterInstant> shutter = {});
 
   // Linear radiance of the proxy room, textured by projecting the environment map
   // from its capture point, seen by a pinhole `camera` (any size; distortion ignored).
