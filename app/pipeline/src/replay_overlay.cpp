@@ -103,7 +103,9 @@ std::vector<std::optional<Pose>> ReplayOverlay::shutter_cameras(const capture::F
   const std::vector<Nanos> times = overlay_->shutter_times(frame.time);
   if (!pose || times.empty()) return {};
   std::vector<std::optional<Pose>> out;
-  const std::optional<Pose> tracked = replay_.tracked_camera_pose(frame.time);
+  // Only the tracker's motion is taken from it, so it is looked up once, not for the truth.
+  const std::optional<Pose> tracked =
+      pose_source_ == PoseSource::Truth ? std::nullopt : replay_.tracked_camera_pose(frame.time);
   for (const Nanos t : times) {
     if (t == frame.time) {  // the frame's own pose, bit for bit: the renderer draws that instant once
       out.push_back(pose);

@@ -128,6 +128,10 @@ struct Renderer::Impl {
     glm::vec3 lo{0.0f}, hi{0.0f};  // model-space bounds
     bool vertex_lit = false;       // shaded by its per-vertex irradiance (set_object_vertex_irradiance)
     int level = 0;                 // of its simplified meshes, for this frame's coverage (choose_levels)
+    void set_pose(const glm::dmat4& T_world_model) {
+      model = glm::mat4(T_world_model);
+      normal_matrix = glm::mat3(glm::transpose(glm::inverse(glm::dmat3(T_world_model))));
+    }
   };
 
   // Each object's coarsest mesh level within coverage_error_px of its mesh, where the
@@ -385,10 +389,7 @@ struct Renderer::Impl {
   }
 
   void pose_objects(const std::vector<glm::dmat4>& T_world_model) {
-    for (std::size_t i = 0; i < objects.size(); ++i) {
-      objects[i].model = glm::mat4(T_world_model[i]);
-      objects[i].normal_matrix = glm::mat3(glm::transpose(glm::inverse(glm::dmat3(T_world_model[i]))));
-    }
+    for (std::size_t i = 0; i < objects.size(); ++i) objects[i].set_pose(T_world_model[i]);
   }
   // The objects' poses as set, to put back after drawing them elsewhere.
   using KeptPoses = std::vector<std::pair<glm::mat4, glm::mat3>>;
@@ -591,9 +592,7 @@ int Renderer::add_object(const Mesh& mesh_model) {
 }
 
 void Renderer::set_object_pose(int id, const glm::dmat4& T_world_model) {
-  Impl::Object& o = impl_->object(id, "set_object_pose");
-  o.model = glm::mat4(T_world_model);
-  o.normal_matrix = glm::mat3(glm::transpose(glm::inverse(glm::dmat3(T_world_model))));
+  impl_->object(id, "set_object_pose").set_pose(T_world_model);
 }
 
 void Renderer::set_object_light_attenuation(int id, std::span<const glm::vec3> attenuation) {
@@ -789,9 +788,10 @@ cv::Mat Renderer::render_overlay(const cv::Mat& video_bgr8, const std::optional<
   // Antialiasing and blur change `scene` in place, only within the objects' footprint.
   const bool antialiasing = r.features.antialiasing && r.multisampled.samples > 1;
   const bool blur = r.features.blur && r.blur_sigma > 0.0f;
+  const glm::mat4 vp = T_world_camera ? Impl::view_projection(r.camera, *T_world_camera) : glm::mat4(1.0f);
+  const cv::Rect footprint = T_world_camera && (antialiasing || blur) ? r.objects_footprint(vp) : cv::Rect();
   if (T_world_camera && antialiasing) {
-    const glm::mat4 vp = Impl::view_projection(r.camera, *T_world_camera);
-    r.antialias(vp, r.objects_footprint(vp), *T_world_camera);
+    r.antialias(vp, footprint, *T_world_camera);
     clock.mark(&t.antialiasing_ms);
   }
   if (!moving.empty()) {
@@ -799,8 +799,6 @@ cv::Mat Renderer::render_overlay(const cv::Mat& video_bgr8, const std::optional<
     clock.mark(&t.motion_blur_ms);
   }
   if (T_world_camera && blur) {
-    const glm::mat4 vp = Impl::view_projection(r.camera, *T_world_camera);
-    const cv::Rect footprint = r.objects_footprint(vp);
     r.blur_rendered(Impl::bounding(footprint, moving));
     clock.mark(&t.blur_ms);
   }
