@@ -378,9 +378,10 @@ case_irradiance_cache_said_once_and_skippable() {
   export XDG_CACHE_HOME="$TMP/cache"
   "$LUMAR" overlay --recording "$REC" --max-frames 1 --frames-dir "$TMP/f1" >"$TMP/log1" 2>&1 || fail "overlay failed"
   grep -q "cached as $TMP/cache/lumar/irradiance-" "$TMP/log1" || { cat "$TMP/log1"; fail "the cache was not named"; }
-  # The volume and the shadow lines.
+  # The volume, and the shadow lines of the receivers and of the contact receivers.
   [ "$(ls "$TMP/cache/lumar" | grep -c '^irradiance-')" -eq 1 ] || fail "no volume in \$XDG_CACHE_HOME/lumar"
-  [ "$(ls "$TMP/cache/lumar" | grep -c '^shadow-lines-')" -eq 1 ] || fail "no shadow lines in \$XDG_CACHE_HOME/lumar"
+  [ "$(ls "$TMP/cache/lumar" | grep -c '^shadow-lines-')" -eq 2 ] ||
+    fail "not two sets of shadow lines (receivers, contact) in \$XDG_CACHE_HOME/lumar"
   "$LUMAR" overlay --recording "$REC" --max-frames 1 --frames-dir "$TMP/f2" >"$TMP/log2" 2>&1 || fail "overlay failed"
   ! grep -q "cached as" "$TMP/log2" || fail "the cache was announced again"
   export XDG_CACHE_HOME="$TMP/other"

@@ -82,6 +82,13 @@ Overlay::Overlay(std::shared_ptr<const LoadedScene> scene, const CameraIntrinsic
       quality_(settings.quality),
       scene_(scene) {
   check_quality(quality_);
+  shutter_s_ = settings.shutter_s.value_or(radiometry.shutter_s);
+  if (!(shutter_s_ >= 0.0 && shutter_s_ <= 1.0))
+    throw InputError(fmt::format("overlay: a shutter time of {} s; use 0 (no motion blur) to 1 s", shutter_s_));
+  shutter_instants_ = settings.shutter_instants;
+  if (shutter_instants_ < OverlaySettings::kMinShutterInstants || shutter_instants_ > OverlaySettings::kMaxShutterInstants)
+    throw InputError(fmt::format("overlay: {} shutter instants; use {} to {}", shutter_instants_,
+                                 OverlaySettings::kMinShutterInstants, OverlaySettings::kMaxShutterInstants));
   if (settings.window) {
     const char* display = std::getenv("DISPLAY");
     if (!display || !*display)
@@ -99,23 +106,15 @@ Overlay::Overlay(std::shared_ptr<const LoadedScene> scene, const CameraIntrinsic
   maps_ = calib::make_undistortion_maps(camera, settings.undistortion);
   const calib::UndistortionMaps& maps = maps_;
   compositor_ = std::make_unique<Compositor>(with_volume_knobs(std::move(scene), quality_), maps.output, maps.map_x,
-                                             maps.map_y, settings.volume_cache);
+                                             maps.map_y,
+                                             CompositorSettings{settings.volume_cache, settings.features, quality_.shadows});
   // The renderer's linear unit is the response's (sRGB with gain 1 without one).
   response_ = response.value_or(calib::srgb_response(1.0));
   radiometry_ = renderer_radiometry(radiometry, camera, response);
   noise_known_ = !settings.features.noise;
   blur_known_ = !settings.features.blur;
   if (settings.blur_sigma_px >= 0) radiometry_.blur_sigma_px = settings.blur_sigma_px, blur_known_ = true;
-  shutter_s_ = settings.shutter_s.value_or(radiometry.shutter_s);
-  if (!(shutter_s_ >= 0.0 && shutter_s_ <= 1.0))
-    throw InputError(fmt::format("overlay: a shutter time of {} s; use 0 (no motion blur) to 1 s", shutter_s_));
-  shutter_instants_ = settings.shutter_instants;
-  if (shutter_instants_ < OverlaySettings::kMinShutterInstants || shutter_instants_ > OverlaySettings::kMaxShutterInstants)
-    throw InputError(fmt::format("overlay: {} shutter instants; use {} to {}", shutter_instants_,
-                                 OverlaySettings::kMinShutterInstants, OverlaySettings::kMaxShutterInstants));
-  compositor_->set_features(settings.features);
   compositor_->set_object_shading(quality_.shading);
-  compositor_->set_shadow_quality(quality_.shadows);
   compositor_->renderer().set_coverage_mesh_error(quality_.coverage_mesh_px);
   compositor_->renderer().set_video_radiometry(radiometry_);
   lighting_cells_ = settings.adapt_lighting_cells;
@@ -181,10 +180,8 @@ void Overlay::set_scene(std::shared_ptr<const LoadedScene> scene) {
   scene_ = scene;
   compositor_.reset();  // its GL objects go first
   compositor_ = std::make_unique<Compositor>(with_volume_knobs(std::move(scene), quality_), maps_.output, maps_.map_x,
-                                             maps_.map_y, volume_cache_);
-  compositor_->set_features(features);
+                                             maps_.map_y, CompositorSettings{volume_cache_, features, quality_.shadows});
   compositor_->set_object_shading(quality_.shading);
-  compositor_->set_shadow_quality(quality_.shadows);
   compositor_->renderer().set_coverage_mesh_error(quality_.coverage_mesh_px);
   compositor_->renderer().set_video_radiometry(radiometry_);
   set_adapt_lighting_every(lighting_every_);

@@ -4,9 +4,11 @@
 
 #include <chrono>
 #include <exception>
+#include <future>
 #include <thread>
 
 #include "lumar/base/error.h"
+#include "lumar/render/platform/context.h"
 #include "stage_queue.h"
 
 namespace lumar::pipeline {
@@ -42,6 +44,10 @@ ReplayOverlay::ReplayOverlay(const std::filesystem::path& recording, const Repla
                      " closed frames can be replayed with --allow-incomplete");
   const std::filesystem::path scene_path = settings.scene.empty() ? replay_.scene_path() : settings.scene;
   if (scene_path.empty()) throw InputError((recording / "session.json").string() + ": names no scene; pass --scene");
+  // The GL driver loads while the scene is read (headless only: a window's toolkit starts
+  // on the main thread).
+  std::future<void> driver;
+  if (!settings.overlay.window) driver = std::async(std::launch::async, gl::load_headless_driver);
   auto scene = std::make_shared<const LoadedScene>(load_scene_files(scene_path));
   if (pose_source_ == PoseSource::Truth && replay_.reader().truth().empty())
     throw InputError(recording.string() + ": has no ground truth (truth.csv); use the tracker's poses");

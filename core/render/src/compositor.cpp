@@ -6,6 +6,8 @@
 
 #include <algorithm>
 #include <chrono>
+#include <future>
+#include <memory>
 
 #include "lumar/base/error.h"
 #include "lumar/lighting/irradiance_scene.h"
@@ -38,19 +40,65 @@ struct Compositor::ContactShadows {
   std::vector<glm::vec3> correction;
 };
 
+// The receivers' shadow lines, the light the objects reflect onto them, and with two
+// objects or more their shadows on each other: CPU work, on a worker thread.
+struct Compositor::ReceiverShadows {
+  Mesh receivers;
+  std::shared_ptr<const Emitters> emitters;
+  std::shared_ptr<LineShadows> lines;     // null without receivers
+  std::shared_ptr<ObjectBounce> bounce;   // with the lines
+  std::shared_ptr<ObjectShadows> object_shadows;  // null with fewer than two objects
+  std::chrono::steady_clock::time_point started;
+};
+
+// The compositor's work off the calling thread (the shadows at start-up, the contact
+// patch), as TBB tasks: run on TBB's own worker threads, or by a thread that waits on
+// the group, never on a thread of its own (threads that come and go between TBB's loops
+// pass its task memory between them where ThreadSanitizer cannot see it). A task owns
+// what it reads; its result comes back through a std::future.
+struct Compositor::Workers {
+  tbb::task_group group;
+  template <class F>
+  auto run(F work) -> std::future<decltype(work())> {
+    auto task = std::make_shared<std::packaged_task<decltype(work())()>>(std::move(work));
+    auto result = task->get_future();
+    group.run([task] { (*task)(); });  // an exception goes to the future
+    return result;
+  }
+  ~Workers() { group.wait(); }
+};
+
 const LineShadows* Compositor::contact_shadows() const { return contact_ ? contact_->lines.get() : nullptr; }
 
+namespace {
+
+void check(const ShadowQuality& quality) {
+  if (quality.emitter_patches < 1 || quality.lines_per_patch < 1)
+    throw InputError("shadow quality: emitter patches and lines per patch must be at least 1");
+}
+
+}  // namespace
+
 Compositor::Compositor(std::shared_ptr<const LoadedScene> scene, const CameraIntrinsics& output_camera,
-                       const cv::Mat& map_x, const cv::Mat& map_y, bool volume_cache)
-    : camera_(output_camera.without_distortion()), scene_(std::move(scene)), cache_(volume_cache) {
+                       const cv::Mat& map_x, const cv::Mat& map_y, const CompositorSettings& settings)
+    : camera_(output_camera.without_distortion()),
+      scene_(std::move(scene)),
+      cache_(settings.cache),
+      workers_(std::make_unique<Workers>()),
+      shadow_quality_(settings.shadows) {
+  check(shadow_quality_);
   const LoadedScene& s = *scene_;
+  for (const LoadedObject& object : s.objects) poses_.push_back(object.T_world_model);
+  // The shadows are traced (or loaded) on worker threads while the renderer is set up here.
+  std::future<ReceiverShadows> shadows = start_shadows(settings.features);
   sh_ = project_radiance_sh9(s.map);
   renderer_ = std::make_unique<gl::Renderer>(camera_);
+  renderer_->set_features(settings.features);
   if (s.room.triangle_count() > 0) renderer_->set_room(s.room);
   // Spatially varying light: the irradiance volume over the movement box (cached on disk).
   if (const std::string& method = s.manifest.lighting.method; method != "sh9") {
     bool loaded = false;
-    volume_ = std::make_shared<const IrradianceVolume>(scene_irradiance_volume(s, method, volume_cache, {}, &loaded));
+    volume_ = std::make_shared<const IrradianceVolume>(scene_irradiance_volume(s, method, cache_, {}, &loaded));
     renderer_->set_irradiance_volume(volume_.get());
     spdlog::debug("irradiance volume ({}): {} probes, {}", volume_->settings().describe(), volume_->stats().probes,
                   loaded ? "loaded from the cache" : "built");
@@ -65,7 +113,6 @@ Compositor::Compositor(std::shared_ptr<const LoadedScene> scene, const CameraInt
     // Every k-th vertex, so that checks see the whole object at a bounded cost.
     const Mesh& mesh = object.model;
     const std::size_t step = std::max<std::size_t>(1, mesh.positions.size() / 200);
-    poses_.push_back(object.T_world_model);
     albedo_.push_back(object.albedo);
     sampled_points_.emplace_back();
     for (std::size_t i = 0; i < mesh.positions.size(); i += step)
@@ -76,9 +123,12 @@ Compositor::Compositor(std::shared_ptr<const LoadedScene> scene, const CameraInt
   lights_blocked_.assign(s.objects.size(), {});
   lights_blocked_stale_.assign(s.objects.size(), 1);
   pose_object_points();
-  build_shadows();
-  set_features(renderer_->features());
+  if (settings.features.self_occlusion) bake_self_occlusion_once();
+  workers_->group.wait();  // this thread helps with the shadows, and the contact patch if it started
+  take_shadows(shadows.get());
 }
+
+Compositor::~Compositor() = default;
 
 void Compositor::pose_object_points() {
   object_points_.clear();
@@ -126,15 +176,15 @@ const ShadowScene& Compositor::shadow_scene() {
   return *shadow_scene_;
 }
 
-// Precomputes the shadow lines from the scene's receivers to its emitters (the objects
-// are the occluders), and with two objects or more their shadows on each other.
-void Compositor::build_shadows() {
+// Ranks the emitters for the scene's receivers (the objects are the occluders), starts the
+// contact build, and the lines' trace or load on a worker thread; take_shadows takes them.
+std::future<Compositor::ReceiverShadows> Compositor::start_shadows(const gl::CompositeFeatures& features) {
   const auto t0 = std::chrono::steady_clock::now();
   const ShadowScene& shadow_scene = this->shadow_scene();
   const auto& objects = shadow_scene.objects();
   const Mesh receivers = shadow_scene.receivers();
   const bool on_receivers = receivers.triangle_count() > 0 && !objects.empty();
-  if (!on_receivers && objects.size() < 2) return;
+  if (!on_receivers && objects.size() < 2) return workers_->run([] { return ReceiverShadows{}; });
   // Emitters ranked for the receivers or, without any, for the objects' own surfaces.
   Mesh around = receivers;
   if (!on_receivers)
@@ -146,46 +196,64 @@ void Compositor::build_shadows() {
   EmitterOptions options;
   options.max_patches = shadow_quality_.emitter_patches;
   options.samples_per_patch = shadow_quality_.lines_per_patch;
-  const Emitters emitters = shadow_scene.emitters(around.positions, around.normals, options);
+  auto emitters = std::make_shared<const Emitters>(shadow_scene.emitters(around.positions, around.normals, options));
   if (on_receivers) {
-    receivers_ = receivers;
-    emitters_ = std::make_shared<const Emitters>(emitters);
-    shadows_ = std::make_shared<LineShadows>(
-        cache_
-            ? cached_shadow_lines(receivers.positions, receivers.normals, emitters, shadow_scene.proxy(), scene_->room)
-            : build_shadow_lines(receivers.positions, receivers.normals, emitters, shadow_scene.proxy()));
-    for (std::size_t i = 0; i < objects.size(); ++i) shadows_->add_object(objects[i].model, poses_[i]);
-    renderer_->set_receivers(receivers);
-    bounce_ =
-        std::make_shared<ObjectBounce>(shadows_->lines().origins, receivers.normals, shadows_->lines().unshadowed);
-    for (std::size_t i = 0; i < objects.size(); ++i) {
-      bounce_->add_object(objects[i].model, objects[i].albedo, poses_[i]);
-      bounce_->set_object_enabled(int(i), objects[i].bounce);
-    }
-    give_bounce_occlusion();
-    spdlog::debug("shadows: {} receivers, {} emitter patches, {} lines, built in {:.0f} ms", receivers.positions.size(),
-                  emitters.patches.size(), shadows_->lines().lines.size(),
-                  std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+    receivers_ = receivers, emitters_ = emitters;
+    start_contact_build(features);  // it needs only the receivers and the emitters
   }
-  if (objects.size() >= 2) {
-    object_shadows_ = std::make_shared<ObjectShadows>(emitters);
-    for (std::size_t i = 0; i < objects.size(); ++i) object_shadows_->add_object(objects[i].model, poses_[i]);
-    spdlog::debug("objects shadow each other: {} objects, {} emitter samples", objects.size(), emitters.samples.size());
+  return workers_->run([t0, on_receivers, emitters, receivers, rays = shadow_scene_,
+                                         scene = scene_, poses = poses_, cache = cache_] {
+    ReceiverShadows out{on_receivers ? receivers : Mesh{}, emitters, {}, {}, {}, t0};
+    const auto& objects = scene->objects;
+    if (on_receivers) {
+      out.lines = std::make_shared<LineShadows>(
+          cache ? cached_shadow_lines(receivers.positions, receivers.normals, *emitters, rays->proxy(), scene->room)
+                : build_shadow_lines(receivers.positions, receivers.normals, *emitters, rays->proxy()));
+      for (std::size_t i = 0; i < objects.size(); ++i) out.lines->add_object(objects[i].model, poses[i]);
+      out.bounce =
+          std::make_shared<ObjectBounce>(out.lines->lines().origins, receivers.normals, out.lines->lines().unshadowed);
+      for (std::size_t i = 0; i < objects.size(); ++i) {
+        out.bounce->add_object(objects[i].model, objects[i].albedo, poses[i]);
+        out.bounce->set_object_enabled(int(i), objects[i].bounce);
+      }
+    }
+    if (objects.size() >= 2) {
+      out.object_shadows = std::make_shared<ObjectShadows>(*emitters);
+      for (std::size_t i = 0; i < objects.size(); ++i) out.object_shadows->add_object(objects[i].model, poses[i]);
+    }
+    return out;
+  });
+}
+
+void Compositor::take_shadows(ReceiverShadows built) {
+  if (built.lines) {
+    shadows_ = std::move(built.lines);
+    bounce_ = std::move(built.bounce);
+    renderer_->set_receivers(built.receivers);
+    give_bounce_occlusion();
+    spdlog::debug("shadows: {} receivers, {} emitter patches, {} lines, built in {:.0f} ms",
+                  built.receivers.positions.size(), built.emitters->patches.size(), shadows_->lines().lines.size(),
+                  std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - built.started).count());
+  }
+  if (built.object_shadows) {
+    object_shadows_ = std::move(built.object_shadows);
+    spdlog::debug("objects shadow each other: {} objects, {} emitter samples", object_shadows_->object_count(),
+                  built.emitters->samples.size());
   }
 }
 
 void Compositor::set_shadow_quality(const ShadowQuality& quality) {
   if (quality == shadow_quality_) return;
-  if (quality.emitter_patches < 1 || quality.lines_per_patch < 1)
-    throw InputError("shadow quality: emitter patches and lines per patch must be at least 1");
+  check(quality);
   shadow_quality_ = quality;
+  contact_build_ = {};  // its lines are to the old emitters: dropped when done
   shadows_.reset();
   sphere_shadows_.reset();
   object_shadows_.reset();
   bounce_.reset();
   contact_.reset();
   contact_uploaded_ = false;
-  build_shadows();
+  take_shadows(start_shadows(renderer_->features()).get());
   relight_shadows();
   shadows_uploaded_ = object_shadows_uploaded_ = false;
 }
@@ -246,40 +314,79 @@ std::vector<glm::vec3> Compositor::emitter_sample_scale() const {
   return sample_scale;
 }
 
-// Builds the contact receivers once the objects have stood still long enough, drops them
-// when one moves, and hands the renderer what changed.
-void Compositor::update_contact_shadows(FrameLight& light, bool lines_on) {
+// The contact receivers of objects at `poses`, their lines traced and blocked (not relit:
+// the room's change is applied when they are taken, as it may change meanwhile). Runs on
+// a worker thread: everything it reads is its own or immutable.
+std::shared_ptr<Compositor::ContactShadows> Compositor::build_contact_shadows(
+    std::shared_ptr<const ShadowScene> shadow_scene, Mesh coarse, std::shared_ptr<const Emitters> emitters,
+    std::shared_ptr<const LoadedScene> scene, std::vector<glm::dmat4> poses, bool cache) {
+  const auto t0 = std::chrono::steady_clock::now();
+  auto built = std::make_shared<ContactShadows>();
+  std::vector<const Mesh*> models;
+  for (const LoadedObject& o : scene->objects) models.push_back(&o.model);
+  const ContactSettings settings;
+  built->patch =
+      build_contact_patch(shadow_scene->proxy(), coarse,
+                          contact_regions(shadow_scene->receiver_regions(), models, poses, settings.reach), settings);
+  if (!built->patch.empty()) {
+    const Mesh& patch = built->patch.receivers;
+    built->lines = std::make_unique<LineShadows>(
+        cache ? cached_shadow_lines(patch.positions, patch.normals, *emitters, shadow_scene->proxy(), scene->room)
+              : build_shadow_lines(patch.positions, patch.normals, *emitters, shadow_scene->proxy()));
+    for (std::size_t i = 0; i < poses.size(); ++i) built->lines->add_object(scene->objects[i].model, poses[i]);
+    built->lines->update();
+    spdlog::debug("contact shadows: {} receivers, {} lines, built in {:.0f} ms", patch.positions.size(),
+                  built->lines->lines().lines.size(),
+                  std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+  }
+  built->poses = std::move(poses);
+  return built;
+}
+
+bool Compositor::contact_wanted(const gl::CompositeFeatures& features) const {
+  return emitters_ && shadows_enabled_ && features.lines && features.contact;
+}
+
+// Starts the contact build for the objects' poses now, when they are wanted, at rest and
+// not built or under way. A build for poses that are no longer the objects' is waited
+// for first (one worker at a time).
+void Compositor::start_contact_build(const gl::CompositeFeatures& features) {
+  if (!contact_wanted(features) || frames_at_rest_ < kRestFrames || (contact_ && contact_->poses == poses_)) return;
+  if (contact_build_.valid() && contact_build_poses_ == poses_) return;
+  contact_build_poses_ = poses_;
+  contact_build_ = workers_->run([rays = shadow_scene_, coarse = receivers_, emitters = emitters_, scene = scene_,
+                                  poses = poses_, cache = cache_] {
+    return build_contact_shadows(rays, coarse, emitters, scene, poses, cache);
+  });
+}
+
+// The build under way, when it is for the objects' poses (waiting for it), relit to the
+// room's light and with its correction of the coarse shadow; one for other poses is
+// dropped once it is done.
+void Compositor::take_contact_build() {
+  if (!contact_build_.valid()) return;
+  if (contact_build_poses_ != poses_) {
+    contact_build_ = {};  // for a pose the objects left: its result is dropped when done
+    return;
+  }
+  contact_ = contact_build_.get();
+  if (contact_->lines) {
+    if (light_scale_.rgb.size() > 1) contact_->lines->relight(emitter_sample_scale());
+    contact_->correction = contact_->patch.correction(contact_->lines->attenuation(), shadows_->attenuation());
+  }
+  contact_uploaded_ = false;
+}
+
+// Drops the contact receivers when an object moved, takes them in once the objects have
+// stood still long enough, and hands the renderer what changed.
+void Compositor::update_contact_shadows(FrameLight& light) {
   if (contact_ && contact_->poses != poses_) {
     contact_.reset();
     contact_uploaded_ = false;
   }
-  const bool wanted = lines_on && renderer_->features().lines && renderer_->features().contact && emitters_;
-  if (wanted && !contact_ && frames_at_rest_ >= kRestFrames) {
-    const auto t0 = std::chrono::steady_clock::now();
-    auto built = std::make_shared<ContactShadows>();
-    built->poses = poses_;
-    const ShadowScene& shadow_scene = this->shadow_scene();
-    std::vector<const Mesh*> models;
-    for (const LoadedObject& o : scene_->objects) models.push_back(&o.model);
-    const ContactSettings settings;
-    built->patch =
-        build_contact_patch(shadow_scene.proxy(), receivers_,
-                            contact_regions(shadow_scene.receiver_regions(), models, poses_, settings.reach), settings);
-    if (!built->patch.empty()) {
-      const Mesh& patch = built->patch.receivers;
-      built->lines = std::make_unique<LineShadows>(
-          build_shadow_lines(patch.positions, patch.normals, *emitters_, shadow_scene.proxy()));
-      for (std::size_t i = 0; i < poses_.size(); ++i) built->lines->add_object(scene_->objects[i].model, poses_[i]);
-      if (light_scale_.rgb.size() > 1) built->lines->relight(emitter_sample_scale());
-      built->lines->update();
-      built->correction = built->patch.correction(built->lines->attenuation(), shadows_->attenuation());
-      spdlog::debug("contact shadows: {} receivers, {} lines, built in {:.0f} ms", patch.positions.size(),
-                    built->lines->lines().lines.size(),
-                    std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
-    }
-    contact_ = std::move(built);
-    contact_uploaded_ = false;
-  }
+  const bool wanted = contact_wanted(renderer_->features());
+  if (wanted && !contact_ && frames_at_rest_ >= kRestFrames) start_contact_build(renderer_->features());
+  take_contact_build();
   contact_pending_ = wanted && !contact_;
   if (contact_uploaded_) return;
   if (wanted && contact_ && contact_->lines)
@@ -401,8 +508,9 @@ FrameLight Compositor::prepare() {
       light.object_shadowing.push_back(object_shadows_->vertex_attenuation(int(i)));
     object_shadows_uploaded_ = true;
   }
-  update_contact_shadows(light, lines && !spheres);
-  if (frames_at_rest_ < kRestFrames) ++frames_at_rest_;
+  update_contact_shadows(light);
+  if (frames_at_rest_ < kRestFrames && ++frames_at_rest_ == kRestFrames)
+    start_contact_build(renderer_->features());  // for the next frame
   shadow_objects_themselves(light);
   const auto t1 = std::chrono::steady_clock::now();
   light_vertices(light);

@@ -1,5 +1,7 @@
 #include "lumar/scene/loaded_scene.h"
 
+#include <exception>
+#include <future>
 #include <limits>
 
 #include <spdlog/spdlog.h>
@@ -113,25 +115,33 @@ void place_object(const Scene& manifest, std::size_t index, const SceneObject& o
 LoadedScene load_scene_files(const Scene& manifest) {
   LoadedScene out;
   out.manifest = manifest;
-  out.map = load_environment_map(manifest.environment_map);
+  // The map decodes on its own thread while the meshes do on this one.
+  auto map = std::async(std::launch::async, [&] { return load_environment_map(manifest.environment_map); });
+  std::exception_ptr meshes_error;
+  try {
+    if (!manifest.room_mesh.empty())
+      out.room = transformed(load_mesh(manifest.room_mesh), glm::dmat4(glm::dmat3(manifest.room_scale)));
+    // Objects that share a mesh file share one decode.
+    std::map<std::filesystem::path, const Mesh*> decoded;
+    out.objects.reserve(manifest.objects.size());  // the pointers above stay valid
+    for (std::size_t i = 0; i < manifest.objects.size(); ++i) {
+      const SceneObject& o = manifest.objects[i];
+      LoadedObject object{o.name, {}, o.T_world_model, o.albedo, {}, o.bounce};
+      if (const auto it = decoded.find(o.mesh); it != decoded.end())
+        object.model = *it->second;
+      else
+        object.model = load_mesh(o.mesh);
+      place_object(manifest, i, o, out.room, object);
+      out.objects.push_back(std::move(object));
+      decoded.emplace(o.mesh, &out.objects.back().model);
+    }
+  } catch (...) {
+    meshes_error = std::current_exception();
+  }
+  out.map = map.get();  // a bad map is reported first, as when they were read in turn
+  if (meshes_error) std::rethrow_exception(meshes_error);
   out.map.capture_position = manifest.capture_position;
   out.map.azimuth_offset_deg = manifest.azimuth_offset_deg;
-  if (!manifest.room_mesh.empty())
-    out.room = transformed(load_mesh(manifest.room_mesh), glm::dmat4(glm::dmat3(manifest.room_scale)));
-  // Objects that share a mesh file share one decode.
-  std::map<std::filesystem::path, const Mesh*> decoded;
-  out.objects.reserve(manifest.objects.size());  // the pointers above stay valid
-  for (std::size_t i = 0; i < manifest.objects.size(); ++i) {
-    const SceneObject& o = manifest.objects[i];
-    LoadedObject object{o.name, {}, o.T_world_model, o.albedo, {}, o.bounce};
-    if (const auto it = decoded.find(o.mesh); it != decoded.end())
-      object.model = *it->second;
-    else
-      object.model = load_mesh(o.mesh);
-    place_object(manifest, i, o, out.room, object);
-    out.objects.push_back(std::move(object));
-    decoded.emplace(o.mesh, &out.objects.back().model);
-  }
   return out;
 }
 

@@ -106,4 +106,11 @@ class HeadlessContext : public Context {
 
 std::unique_ptr<Context> create_headless_context() { return std::make_unique<HeadlessContext>(); }
 
+void load_headless_driver() {
+  try {
+    surfaceless_display();
+  } catch (const RuntimeError&) {
+  }
+}
+
 }  // namespace lumar::gl

@@ -2,6 +2,7 @@
 // The overlay for one scene and one camera: proxy room for occlusion, virtual objects
 // shaded from the environment map, composited over undistorted video. Set up once,
 // then one call per frame. Needs a current OpenGL context (gl/context.h).
+#include <future>
 #include <memory>
 #include <opencv2/core.hpp>
 #include <optional>
@@ -63,16 +64,26 @@ struct FrameLight {
   double shadows_ms = 0, vertex_light_ms = 0;
 };
 
+// What a compositor starts with. Each can change later (Compositor::set_features,
+// set_shadow_quality), at the cost of the work that redoes; given here, the shadows are
+// built once, and what is switched off is never built.
+struct CompositorSettings {
+  // Load the irradiance volume and the shadow lines (the contact receivers' too) from the
+  // disk cache, and store them there once built (lighting/irradiance_volume.h,
+  // lighting/shadows/shadow_line_cache.h); false: build them every time.
+  bool cache = true;
+  gl::CompositeFeatures features;  // all on
+  ShadowQuality shadows;
+};
+
 class Compositor {
  public:
   // `output_camera`: the undistorted camera the renderer draws with. `map_x`, `map_y`:
   // for each output pixel, where to sample the distorted video (may be empty when the
   // video is already undistorted).
-  // `volume_cache`: load the irradiance volume and the shadow lines from the disk cache,
-  // and store them there once built (lighting/irradiance_volume.h,
-  // lighting/shadows/shadow_line_cache.h); false: build them every time.
   Compositor(std::shared_ptr<const LoadedScene> scene, const CameraIntrinsics& output_camera, const cv::Mat& map_x,
-             const cv::Mat& map_y, bool volume_cache = true);
+             const cv::Mat& map_y, const CompositorSettings& settings = {});
+  ~Compositor();
 
   // Composites one BGR8 video frame seen from T_world_camera (nullopt: no pose, the
   // undistorted video alone); `exposure` is the video's linear value per unit of scene radiance.
@@ -129,7 +140,10 @@ class Compositor {
   // The contact receivers' lines (lighting/shadows/contact_receivers.h), or nullptr while
   // there are none: they are built once the objects have stood still for kRestFrames
   // prepared frames (at once for objects that never move), and dropped when one moves,
-  // since a patch at every pose of a moving object would cost a build per frame.
+  // since a patch at every pose of a moving object would cost a build per frame. The build
+  // runs on a worker thread from the moment it can start (for objects that never move,
+  // while the coarse shadows are still loading), and the prepare() that first shows them
+  // waits for it: the frames they appear in do not depend on the machine's speed.
   static constexpr int kRestFrames = 3;
   const LineShadows* contact_shadows() const;
   // True while contact receivers are wanted but not built yet: preparing the same frame
@@ -165,8 +179,12 @@ class Compositor {
   // The scene's proxy as rays, built at its first use and shared by every shadow method.
   std::shared_ptr<const ShadowScene> shadow_scene_;  // shared_ptr: incomplete here
   const ShadowScene& shadow_scene();
-  void build_shadows();
+  struct ReceiverShadows;
+  std::future<ReceiverShadows> start_shadows(const gl::CompositeFeatures& features);
+  void take_shadows(ReceiverShadows built);
   bool cache_ = true;  // the volume and the shadow lines from the disk cache
+  struct Workers;
+  std::unique_ptr<Workers> workers_;  // waits for its tasks as it goes
   void bake_self_occlusion_once();
   void give_bounce_occlusion();
   std::vector<std::vector<VertexOcclusion>> self_occlusion_;  // per object, once baked
@@ -192,10 +210,20 @@ class Compositor {
   std::shared_ptr<const Emitters> emitters_;  // the lines' emitters
   struct ContactShadows;
   std::shared_ptr<ContactShadows> contact_;
+  // The build under way on a worker, and the poses it is for.
+  std::future<std::shared_ptr<ContactShadows>> contact_build_;
+  std::vector<glm::dmat4> contact_build_poses_;
   int frames_at_rest_ = kRestFrames;  // prepared frames since an object last moved
   bool contact_uploaded_ = false;
   bool contact_pending_ = false;
-  void update_contact_shadows(FrameLight& light, bool lines_on);
+  static std::shared_ptr<ContactShadows> build_contact_shadows(std::shared_ptr<const ShadowScene> shadow_scene,
+                                                               Mesh coarse, std::shared_ptr<const Emitters> emitters,
+                                                               std::shared_ptr<const LoadedScene> scene,
+                                                               std::vector<glm::dmat4> poses, bool cache);
+  bool contact_wanted(const gl::CompositeFeatures& features) const;
+  void start_contact_build(const gl::CompositeFeatures& features);
+  void take_contact_build();
+  void update_contact_shadows(FrameLight& light);
   std::vector<glm::vec3> emitter_sample_scale() const;
   std::shared_ptr<ObjectBounce> bounce_;
   ShadowQuality shadow_quality_;

@@ -24,6 +24,11 @@ class Context {
 // unset); render into framebuffer objects. Throws RuntimeError when EGL or GL 4.5 is
 // unavailable.
 std::unique_ptr<Context> create_headless_context();
+// Loads and initialises the driver behind create_headless_context (a tenth of a second
+// on llvmpipe), so that a program may do it on another thread while it reads its
+// inputs; thread-safe, and a no-op once done. A failure is left for
+// create_headless_context to report.
+void load_headless_driver();
 
 // A GLFW window with an OpenGL 4.5 core context, current on the calling thread when
 // constructed. Throws RuntimeError when no display can be opened.
