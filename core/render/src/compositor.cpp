@@ -65,6 +65,13 @@ struct Compositor::Workers {
     group.run([task] { (*task)(); });  // an exception goes to the future
     return result;
   }
+  // The result of run(), this thread running the group's tasks meanwhile: with one core
+  // TBB has no worker thread, and only a thread that waits on the group runs them.
+  template <class T>
+  T get(std::future<T>& result) {
+    group.wait();
+    return result.get();
+  }
   ~Workers() { group.wait(); }
 };
 
@@ -124,8 +131,7 @@ Compositor::Compositor(std::shared_ptr<const LoadedScene> scene, const CameraInt
   lights_blocked_stale_.assign(s.objects.size(), 1);
   pose_object_points();
   if (settings.features.self_occlusion) bake_self_occlusion_once();
-  workers_->group.wait();  // this thread helps with the shadows, and the contact patch if it started
-  take_shadows(shadows.get());
+  take_shadows(workers_->get(shadows));  // this thread helps, with the contact patch too if it started
 }
 
 Compositor::~Compositor() = default;
@@ -253,7 +259,8 @@ void Compositor::set_shadow_quality(const ShadowQuality& quality) {
   bounce_.reset();
   contact_.reset();
   contact_uploaded_ = false;
-  take_shadows(start_shadows(renderer_->features()).get());
+  std::future<ReceiverShadows> shadows = start_shadows(renderer_->features());
+  take_shadows(workers_->get(shadows));
   relight_shadows();
   shadows_uploaded_ = object_shadows_uploaded_ = false;
 }
@@ -369,7 +376,7 @@ void Compositor::take_contact_build() {
     contact_build_ = {};  // for a pose the objects left: its result is dropped when done
     return;
   }
-  contact_ = contact_build_.get();
+  contact_ = workers_->get(contact_build_);
   if (contact_->lines) {
     if (light_scale_.rgb.size() > 1) contact_->lines->relight(emitter_sample_scale());
     contact_->correction = contact_->patch.correction(contact_->lines->attenuation(), shadows_->attenuation());
