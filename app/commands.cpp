@@ -30,7 +30,8 @@ void add_composite_options(CLI::App* cmd, CompositeOptions& o) {
       ->check(CLI::Range(0.0, 4.0));
   cmd->add_option("--shutter", o.shutter_s,
                   "How long the camera's shutter was open per frame, seconds, for the objects' motion blur "
-                  "(default: the session's radiometry.shutter_s; 0: no motion blur)");
+                  "(default: live, the camera's exposure time where it says it, else the session's radiometry.shutter_s; "
+                  "0: no motion blur)");
   cmd->add_option("--shutter-instants", o.shutter_instants,
                   "Motion blur: the instants of the shutter the objects are drawn at and averaged over (each costs "
                   "one more drawing of them)")

@@ -28,6 +28,16 @@ PairedFrame FramePosePairing::pair(Frame frame) const {
   return out;
 }
 
+std::optional<Pose> FramePosePairing::camera_at(Nanos t) const {
+  std::optional<Pose> sensor;
+  {
+    std::lock_guard lock(mutex_);
+    sensor = stream_.lookup(t, station_, lookup_).pose;
+  }
+  if (!sensor) return std::nullopt;
+  return rig_.camera_pose(*sensor);
+}
+
 bool FramePosePairing::covers(Nanos t) const {
   std::lock_guard lock(mutex_);
   const auto& s = stream_.samples(station_);

@@ -6,7 +6,10 @@
 namespace lumar::capture {
 
 RecordingSource::RecordingSource(const RecordingReader& recording)
-    : dir_(recording.directory()), video_(recording.video()), frames_(recording.frames()) {}
+    : dir_(recording.directory()),
+      video_(recording.video()),
+      frames_(recording.frames()),
+      shutter_(seconds_to_nanos(recording.session().radiometry.shutter_s)) {}
 
 void RecordingSource::fail_truncated() const {
   throw InputError(segment_file_.string() + ": truncated or corrupt video (decoded " + std::to_string(decoded_) +

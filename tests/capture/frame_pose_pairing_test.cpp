@@ -78,6 +78,15 @@ TEST(FramePosePairing, MatchesTruthWithinTheInterpolationErrorAtAKnownLatency) {
   FramePosePairing stale(rig, 1, forgotten);
   stale.add(samples);
 
+  // Brute-force reference: the true poses at the two sample times around t,
+  // interpolated the same way. That is all a 60 Hz tracker can know.
+  const auto interpolation_error = [&](Nanos t) {
+    const Nanos k = Nanos(std::floor(nanos_to_seconds(t) * rate));
+    const Nanos t0 = std::llround(double(k) * 1e9 / rate), t1 = std::llround(double(k + 1) * 1e9 / rate);
+    const Pose interpolated = interpolate(true_sensor(t0), true_sensor(t1), double(t - t0) / double(t1 - t0));
+    return error(rig.camera_pose(interpolated), rig.camera_pose(true_sensor(t)));
+  };
+
   // Frames at 30 fps, out of phase with the tracker.
   Errors worst, worst_interpolation, worst_stale;
   int frames = 0;
@@ -89,13 +98,7 @@ TEST(FramePosePairing, MatchesTruthWithinTheInterpolationErrorAtAKnownLatency) {
     ASSERT_TRUE(p.T_world_camera);
     const Pose truth = rig.camera_pose(true_sensor(t));
     const Errors e = error(*p.T_world_camera, truth);
-
-    // Brute-force reference: the true poses at the two sample times around t,
-    // interpolated the same way. That is all a 60 Hz tracker can know.
-    const Nanos k = Nanos(std::floor(nanos_to_seconds(t) * rate));
-    const Nanos t0 = std::llround(double(k) * 1e9 / rate), t1 = std::llround(double(k + 1) * 1e9 / rate);
-    const Pose interpolated = interpolate(true_sensor(t0), true_sensor(t1), double(t - t0) / double(t1 - t0));
-    const Errors ei = error(rig.camera_pose(interpolated), truth);
+    const Errors ei = interpolation_error(t);
 
     // Plus the record's quantisation: 0.01 in per axis, 0.01 deg per Euler angle.
     EXPECT_LE(e.position_m, ei.position_m + 0.30e-3) << "t " << t;
@@ -104,6 +107,18 @@ TEST(FramePosePairing, MatchesTruthWithinTheInterpolationErrorAtAKnownLatency) {
     worst.rotation_deg = std::max(worst.rotation_deg, e.rotation_deg);
     worst_interpolation.position_m = std::max(worst_interpolation.position_m, ei.position_m);
     worst_interpolation.rotation_deg = std::max(worst_interpolation.rotation_deg, ei.rotation_deg);
+
+    // Another instant of the frame's shutter (motion blur): the same poses, the same
+    // bounds; at the frame's own time, the paired pose itself.
+    EXPECT_EQ(pairing.camera_at(t)->translation, p.T_world_camera->translation);
+    for (const Nanos dt : {-10'000'000, 10'000'000}) {
+      const std::optional<Pose> then = pairing.camera_at(t + dt);
+      ASSERT_TRUE(then);
+      const Errors et = error(*then, rig.camera_pose(true_sensor(t + dt))), eit = interpolation_error(t + dt);
+      EXPECT_LE(et.position_m, eit.position_m + 0.30e-3) << "t " << t + dt;
+      EXPECT_LE(et.rotation_deg, eit.rotation_deg + 0.015) << "t " << t + dt;
+      EXPECT_GT(error(*then, *p.T_world_camera).position_m, 1e-3);  // the motion is there (>1 mm in 10 ms)
+    }
 
     const PairedFrame ps = stale.pair(f);
     ASSERT_TRUE(ps.T_world_camera);

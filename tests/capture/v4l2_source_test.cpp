@@ -109,6 +109,7 @@ TEST(V4l2Source, PrefersNativeFormatsToLibv4l2Emulation) {
   EXPECT_EQ(r.source->format().fourcc, "RGB3");
   EXPECT_FALSE(r.source->format().emulated);
   EXPECT_TRUE(r.source->format().controls_set.empty());
+  EXPECT_EQ(r.source->shutter_time(), 0);  // its exposure time is not known: no motion blur
 
   cam.formats = {{"BGR3", true}, {"H264", false}};
   auto e = open_scripted(cam);
@@ -280,6 +281,7 @@ TEST(V4l2Source, StartOfExposureStampsMoveForward) {
   V4l2Settings s;
   s.exposure_100us = 200;  // 20 ms
   auto r = open_scripted(cam, s);
+  EXPECT_EQ(r.source->shutter_time(), 20'000'000);  // what the overlay's motion blur spans
   Frame f;
   ASSERT_TRUE(r.source->read(f));
   EXPECT_EQ(f.time, kStart + 10'000'000);

@@ -434,6 +434,20 @@ PY
     --stats-json "$TMP/stats.json" >"$TMP/log" 2>&1 || { cat "$TMP/log"; fail "overlay with the session's shutter failed"; }
   python3 -c "import json; assert json.load(open('$TMP/stats.json'))['stages']['motion blur'] > 0" ||
     fail "the session's shutter_s gave no motion blur"
+  # Live: the source's shutter time (a camera's exposure time; a recording played as a
+  # camera, its session's) gives the motion blur, and `lumar record` keeps it.
+  "$LUMAR" overlay --source "recording:$TMP/rec" --scene "$SRC/data/scenes/room/scene.json" --max-frames 2 \
+    --frames-dir "$TMP/live" --stats-json "$TMP/stats.json" >"$TMP/log" 2>&1 || { cat "$TMP/log"; fail "live overlay with a shutter failed"; }
+  python3 -c "import json; assert json.load(open('$TMP/stats.json'))['stages']['motion blur'] > 0" ||
+    fail "the live source's shutter time gave no motion blur"
+  "$LUMAR" record --source "recording:$TMP/rec" --out "$TMP/rerec" --max-frames 3 >"$TMP/log" 2>&1 ||
+    { cat "$TMP/log"; fail "record from a recording failed"; }
+  python3 -c "import json; assert json.load(open('$TMP/rerec/session.json'))['radiometry']['shutter_s'] == 0.04" ||
+    fail "lumar record did not keep the source's shutter time"
+  "$LUMAR" record --source "video:$SHARED/data/video/vtest.avi" --out "$TMP/rerec2" --max-frames 3 >"$TMP/log" 2>&1 ||
+    { cat "$TMP/log"; fail "record from a video failed"; }
+  python3 -c "import json; assert 'shutter_s' not in json.load(open('$TMP/rerec2/session.json'))['radiometry']" ||
+    fail "lumar record wrote a shutter time a video file does not give"
   python3 - "$TMP/rec/session.json" <<'PY'
 import json, sys
 s = json.load(open(sys.argv[1])); s['radiometry']['shutter_s'] = -0.04; json.dump(s, open(sys.argv[1], 'w'))

@@ -203,6 +203,67 @@ TEST(LiveOverlay, WithoutTheSessionsRadiometryTheFramesDiffer) {
   EXPECT_LT(psnr_first, 40.0);
 }
 
+// A fast orbit (60 degrees in 2 s, 8 frames/s) with the shutter open 100 ms, played as a
+// camera with its own poses: the live path blurs the figurine over the shutter as the
+// replay does with the same (the tracker's) poses, and differs from the frames without.
+TEST(LiveOverlay, BlursTheObjectsOverTheShutterAsTheReplayDoes) {
+  const test::Scratch scratch("live-overlay-motion-blur");
+  sim::SynthSettings s;
+  s.scene = test::source_dir() / "data/scenes/room/scene.json";
+  s.out = scratch.dir / "orbit";
+  s.camera = calib::load_camera_file(test::source_dir() / "data/camera/webcam-640x480.yml").intrinsics;
+  s.frames = 16;
+  s.fps = 8;
+  s.supersample = 1;
+  s.faults.motion_blur_s = 0.1;
+  s.codec = "ffv1";
+  sim::synthesize_recording(s);
+
+  gl::CompositeFeatures features = kNoFeatures;  // motion blur on, noise off: the frames repeat
+  std::map<std::int64_t, cv::Mat> replayed[2];
+  for (const bool blur : {false, true}) {
+    pipeline::ReplayOverlaySettings rs;
+    rs.poses = pipeline::PoseSource::Tracker;
+    rs.overlay.features = features;
+    rs.overlay.features.motion_blur = blur;
+    pipeline::ReplayOverlay replay(s.out, rs);
+    replay.run(0, [&](const pipeline::OverlayFrame& f) {
+      replayed[blur][f.index] = f.composite.clone();
+      return true;
+    });
+  }
+
+  pipeline::LiveOverlayOptions lo;
+  lo.in.source = "recording:" + s.out.string();
+  lo.scene = s.scene;
+  lo.overlay.window = false;
+  lo.overlay.features = features;
+  lo.steady_with_video = false;
+  pipeline::LiveOverlay live(lo);
+  EXPECT_DOUBLE_EQ(live.overlay().shutter_s(), 0.1);  // the source's (the recording's session's)
+  int frames = 0, moved[2] = {0, 0};
+  double worst_psnr_blurred = 99.0;
+  live.run([&](const pipeline::OverlayFrame& f) {
+    if (!f.T_world_camera) return true;
+    ++frames;
+    worst_psnr_blurred = std::min(worst_psnr_blurred, psnr(f.composite, replayed[1].at(f.index)));
+    for (const int blur : {0, 1}) {
+      cv::Mat difference;
+      cv::absdiff(f.composite, replayed[blur].at(f.index), difference);
+      moved[blur] += cv::countNonZero(difference.reshape(1) > 8);
+    }
+    return true;
+  });
+  std::printf(
+      "%d live frames: worst PSNR %.1f dB against the replay's blurred ones; pixel channels more than 8 levels "
+      "off: %d against them, %d against the sharp ones\n",
+      frames, worst_psnr_blurred, moved[1], moved[0]);
+  EXPECT_GE(frames, kFewestLiveFrames);
+  EXPECT_GE(worst_psnr_blurred, 45.0);
+  EXPECT_GT(moved[0], 100 * frames);
+  EXPECT_LT(moved[1], moved[0] / 20);
+}
+
 // Live, with the tracker's usual noise (0.75 deg, 2.5 mm RMS): the video steadies it as on
 // replay. The camera is still, so every live frame's pose is held to the one true pose;
 // the emulator's noise is the same realisation in both runs (its seed). Six seconds, so

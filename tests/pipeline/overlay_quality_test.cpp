@@ -113,6 +113,23 @@ TEST(QualityChoice, KeepsToItsBudgetAndLeavesTheOverlayAtItsChoice) {
   EXPECT_EQ(replay.times().frames, 0);
   EXPECT_FALSE(replay.overlay().first_composite_time());
   EXPECT_THROW(pipeline::choose_quality(replay.overlay(), {probes[0]}, budget), InputError);
+  for (const auto& p : probes) EXPECT_TRUE(p.shutter_cameras.empty());  // the walk has no shutter time
+}
+
+// With a shutter time the trials draw the motion blur, as the run will: each probe carries
+// the camera at the shutter's instants, the frame's own pose in the middle.
+TEST(QualityChoice, ProbesCarryTheCameraOverTheShutter) {
+  pipeline::ReplayOverlaySettings s;
+  s.poses = pipeline::PoseSource::Tracker;
+  s.overlay.shutter_s = 0.04;
+  pipeline::ReplayOverlay replay(test::source_dir() / "recordings/walk", s);
+  const std::vector<pipeline::ProbeFrame> probes = replay.probe_frames(2);
+  ASSERT_EQ(probes.size(), 2u);
+  for (const auto& p : probes) {
+    ASSERT_EQ(p.shutter_cameras.size(), 3u);
+    ASSERT_TRUE(p.shutter_cameras[0] && p.shutter_cameras[1] && p.shutter_cameras[2]);
+    EXPECT_EQ(p.shutter_cameras[1]->translation, p.T_world_camera.translation);
+  }
 }
 
 }  // namespace

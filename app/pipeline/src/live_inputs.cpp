@@ -1,5 +1,6 @@
 #include "lumar/pipeline/live_inputs.h"
 
+#include <algorithm>
 #include <filesystem>
 
 #include "lumar/base/error.h"
@@ -80,9 +81,11 @@ tracking::Rig live_rig(const std::string& session_json, double latency_ms) {
 }
 
 nlohmann::json live_session(const LiveInputOptions& o, const CameraIntrinsics& camera,
-                            const tracking::TrackerDriver* driver) {
+                            const tracking::TrackerDriver* driver, Nanos shutter_time) {
   capture::Session s;
   s.camera = camera;
+  // The overlay blurs the objects' motion over it (docs/ground_truth.md, "Motion blur").
+  s.radiometry.shutter_s = std::min(1.0, nanos_to_seconds(shutter_time));
   s.rig.latency = seconds_to_nanos(o.latency_ms * 1e-3);
   if (driver) {
     const auto& f = driver->settings().format;

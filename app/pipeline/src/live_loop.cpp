@@ -84,11 +84,17 @@ void LiveLoop::wait_for_tracker(Nanos timeout, const std::string& tracker_name) 
   }
 }
 
-std::optional<Pose> LiveLoop::recorded_pose(const capture::Frame& frame) const {
+std::optional<Pose> LiveLoop::recorded_pose(const capture::Frame& frame, Nanos offset) const {
   if (frame.index < 0 || std::size_t(frame.index) >= recorded_times_.size()) return std::nullopt;
   const Nanos t = recorded_times_[std::size_t(frame.index)];
   if (t < 0) return std::nullopt;
-  return recording_->tracked_camera_pose(t);
+  return recording_->tracked_camera_pose(t + offset);
+}
+
+std::optional<Pose> LiveLoop::camera_at(const capture::Frame& frame, Nanos t) const {
+  // A recording played live has its frames restamped; its poses keep the recorded times.
+  if (!driver_ && recording_) return recorded_pose(frame, t - frame.time);
+  return pairing_.camera_at(t);
 }
 
 capture::PairedFrame LiveLoop::pair(capture::Frame frame) {
@@ -105,7 +111,7 @@ capture::PairedFrame LiveLoop::pair(capture::Frame frame) {
     const Nanos deadline = monotonic_now() + settings_.max_wait;
     for (;;) {
       take_samples();
-      if (pairing_.covers(frame.time) || monotonic_now() >= deadline) break;
+      if (pairing_.covers(frame.time + settings_.shutter / 2) || monotonic_now() >= deadline) break;
       std::this_thread::sleep_for(std::chrono::milliseconds(1));
     }
   }

@@ -2,6 +2,7 @@
 
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <chrono>
 
 #include "lumar/base/error.h"
@@ -45,6 +46,10 @@ LiveOverlay::LiveOverlay(const LiveOverlayOptions& o) {
   if (o.vignetting_b) radiometry.vignetting_b = *o.vignetting_b;
   if (o.exposure) radiometry.exposure = *o.exposure;
   if (!(radiometry.exposure > 0)) throw InputError("--exposure must be a positive number");
+  // The camera's own exposure time, where it says it, is the shutter the motion blur
+  // spans (--shutter overrides it); else the session's.
+  if (const Nanos shutter = live.source->shutter_time(); shutter > 0)
+    radiometry.shutter_s = std::min(1.0, nanos_to_seconds(shutter));
 
   tracking::Rig rig = session ? session->rig : tracking::Rig{};
   rig.latency = seconds_to_nanos(in.latency_ms * 1e-3);
@@ -61,6 +66,8 @@ LiveOverlay::LiveOverlay(const LiveOverlayOptions& o) {
   settings.max_wait = seconds_to_nanos(o.max_wait_ms * 1e-3);
   settings.max_frames = o.max_frames;
   settings.filter = o.filter;
+  // With motion blur, a frame waits for the tracker to pass its shutter's end, not only its middle.
+  if (!overlay_->shutter_times(0).empty()) settings.shutter = seconds_to_nanos(overlay_->shutter_s());
   loop_ = std::make_unique<LiveLoop>(std::move(live.source), std::move(driver), rig, settings);
   if (o.steady_with_video) {
     if (overlay_->scene().room.triangle_count() > 0)
@@ -87,10 +94,11 @@ std::pair<int, int> LiveOverlay::quality_probes() const {
   return probe_budget_ ? std::pair{int(probes_.size()), probe_budget_->frames + 1} : std::pair{0, 0};
 }
 
-bool LiveOverlay::probe(const capture::Frame& frame, const std::optional<Pose>& pose) {
+bool LiveOverlay::probe(const capture::Frame& frame, const std::optional<Pose>& pose,
+                        const std::vector<std::optional<Pose>>& shutter_cameras) {
   if (!probe_budget_ || !pose) return false;
   if (!probes_.empty() && nanos_to_seconds(frame.time - probes_.back().frame.time) < kProbeSpacingS) return false;
-  probes_.push_back({{frame.image.clone(), frame.time, frame.index}, *pose});  // the source reuses its buffer
+  probes_.push_back({{frame.image.clone(), frame.time, frame.index}, *pose, shutter_cameras});  // the source reuses its buffer
   if (int(probes_.size()) < probe_budget_->frames + 1) return false;
   const QualityBudget budget = *probe_budget_;
   probe_budget_.reset();
@@ -109,8 +117,10 @@ void LiveOverlay::run(const std::function<bool(const OverlayFrame&)>& sink) {
         times.pose += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
         // The frame a choice was made on waited for it: the stage times start after it.
         const auto first_composite = overlay_->first_composite_time();
-        const bool chose = probe(paired.frame, pose);
-        const OverlayFrame out = overlay_->composite(paired.frame, pose);
+        const std::vector<std::optional<Pose>> shutter = overlay_->shutter_cameras(
+            paired.frame.time, pose, [&](Nanos t) { return loop_->camera_at(paired.frame, t); });
+        const bool chose = probe(paired.frame, pose, shutter);
+        const OverlayFrame out = overlay_->composite(paired.frame, pose, shutter);
         t0 = std::chrono::steady_clock::now();
         const bool go_on = sink(out);
         times.output += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();

@@ -227,6 +227,24 @@ std::vector<Nanos> Overlay::shutter_times(Nanos frame_time) const {
   return out;
 }
 
+std::vector<std::optional<Pose>> Overlay::shutter_cameras(
+    Nanos frame_time, const std::optional<Pose>& pose,
+    const std::function<std::optional<Pose>(Nanos)>& tracked_at) const {
+  const std::vector<Nanos> times = shutter_times(frame_time);
+  if (!pose || times.empty()) return {};
+  const std::optional<Pose> tracked = tracked_at(frame_time);
+  std::vector<std::optional<Pose>> out;
+  for (const Nanos t : times) {
+    if (t == frame_time) {  // the renderer draws that instant once
+      out.push_back(pose);
+      continue;
+    }
+    const std::optional<Pose> then = tracked_at(t);
+    out.push_back(tracked && then ? std::optional<Pose>(*pose * tracked->inverse() * *then) : std::nullopt);
+  }
+  return out;
+}
+
 void Overlay::move_along_paths(Nanos frame_time, bool renderer_too) {
   if (!first_frame_time_) first_frame_time_ = frame_time;
   const double t_s = path_seconds(frame_time);

@@ -28,7 +28,7 @@ QualityTrial run_trial(Overlay& overlay, const std::vector<ProbeFrame>& frames, 
   std::vector<double> ms;
   for (std::size_t i = 0; i < frames.size(); ++i) {
     const auto t0 = std::chrono::steady_clock::now();
-    const OverlayFrame out = overlay.composite(frames[i].frame, frames[i].T_world_camera);
+    const OverlayFrame out = overlay.composite(frames[i].frame, frames[i].T_world_camera, frames[i].shutter_cameras);
     if (i > 0) ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
     if (is_reference) {
       reference.composite.push_back(out.composite);

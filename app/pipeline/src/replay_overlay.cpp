@@ -71,8 +71,8 @@ std::vector<ProbeFrame> ReplayOverlay::probe_frames(int count) {
   capture::Frame frame;
   for (std::size_t i = 0; int(out.size()) < count && frames->read(frame); ++i) {
     if (i * std::size_t(count) < out.size() * total) continue;  // before the next one's place
-    if (const std::optional<Pose> pose = camera_pose(frame))
-      out.push_back({{frame.image.clone(), frame.time, frame.index}, *pose});  // a source may reuse its buffer
+    if (const std::optional<Pose> pose = camera_pose(frame))  // a source may reuse its buffer
+      out.push_back({{frame.image.clone(), frame.time, frame.index}, *pose, shutter_cameras(frame, pose)});
   }
   return out;
 }
@@ -106,22 +106,13 @@ std::optional<Pose> ReplayOverlay::camera_pose(const capture::Frame& frame) {
 
 std::vector<std::optional<Pose>> ReplayOverlay::shutter_cameras(const capture::Frame& frame,
                                                                const std::optional<Pose>& pose) const {
+  if (pose_source_ != PoseSource::Truth)
+    return overlay_->shutter_cameras(frame.time, pose, [&](Nanos t) { return replay_.tracked_camera_pose(t); });
   const std::vector<Nanos> times = overlay_->shutter_times(frame.time);
   if (!pose || times.empty()) return {};
   std::vector<std::optional<Pose>> out;
-  // Only the tracker's motion is taken from it, so it is looked up once, not for the truth.
-  const std::optional<Pose> tracked =
-      pose_source_ == PoseSource::Truth ? std::nullopt : replay_.tracked_camera_pose(frame.time);
-  for (const Nanos t : times) {
-    if (t == frame.time) {  // the frame's own pose, bit for bit: the renderer draws that instant once
-      out.push_back(pose);
-    } else if (pose_source_ == PoseSource::Truth) {
-      out.push_back(replay_.true_camera_pose_at(t));
-    } else {
-      const std::optional<Pose> then = replay_.tracked_camera_pose(t);
-      out.push_back(tracked && then ? std::optional<Pose>(*pose * tracked->inverse() * *then) : std::nullopt);
-    }
-  }
+  for (const Nanos t : times)  // the frame's own pose bit for bit: the renderer draws that instant once
+    out.push_back(t == frame.time ? pose : replay_.true_camera_pose_at(t));
   return out;
 }
 

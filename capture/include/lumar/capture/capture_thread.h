@@ -4,6 +4,7 @@
 // consumer is slow (frame_queue.h). However the thread ends, it closes the queue, so
 // a consumer waiting in pop() wakes up and can ask end() and message() why.
 #include <atomic>
+#include <cmath>
 #include <cstdint>
 #include <memory>
 #include <mutex>
@@ -71,6 +72,8 @@ class RealTimeSource final : public FrameSource {
   cv::Size frame_size() const override { return file_->frame_size(); }
   double nominal_fps() const override { return file_->nominal_fps() * speed_; }
   std::string describe() const override { return file_->describe(); }
+  // In the played-back time, as the frames' times.
+  Nanos shutter_time() const override { return Nanos(std::llround(double(file_->shutter_time()) / speed_)); }
 
  private:
   std::unique_ptr<FrameSource> file_;

@@ -37,6 +37,9 @@ class FramePosePairing {
 
   // The pose at frame.time (+ time_offset).
   PairedFrame pair(Frame frame) const;
+  // The camera pose at any time t (+ time_offset), as pair() gives it at a frame's: the
+  // other instants of a frame's shutter.
+  std::optional<Pose> camera_at(Nanos t) const;
   // Whether a sample at or after t + time_offset has arrived: pairing now interpolates
   // rather than extrapolates. A live loop holds a frame (briefly) until this is true.
   bool covers(Nanos t) const;

@@ -24,6 +24,9 @@ class FrameSource {
   virtual cv::Size frame_size() const = 0;
   virtual double nominal_fps() const = 0;
   virtual std::string describe() const = 0;  // for messages: "recording recordings/orbit"
+  // How long each frame's shutter is open (0: not known): a camera's exposure time, a
+  // recording's session shutter_s. The overlay's motion blur and `lumar record` use it.
+  virtual Nanos shutter_time() const { return 0; }
 };
 
 }  // namespace lumar::capture

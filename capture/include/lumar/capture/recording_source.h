@@ -22,6 +22,7 @@ class RecordingSource : public FrameSource {
   cv::Size frame_size() const override { return video_.size; }
   double nominal_fps() const override { return video_.fps; }
   std::string describe() const override { return "recording " + dir_.string(); }
+  Nanos shutter_time() const override { return shutter_; }  // the session's radiometry.shutter_s
 
  private:
   void open_segment(int segment);
@@ -31,6 +32,7 @@ class RecordingSource : public FrameSource {
   RecordingSettings video_;
   std::vector<FrameEntry> frames_;
   std::size_t next_ = 0;
+  Nanos shutter_ = 0;
 
   cv::VideoCapture capture_;
   int segment_ = -1;  // the open segment

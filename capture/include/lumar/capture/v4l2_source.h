@@ -82,6 +82,7 @@ class V4l2Source final : public FrameSource {
   cv::Size frame_size() const override { return {format_.width, format_.height}; }
   double nominal_fps() const override { return format_.fps > 0 ? format_.fps : settings_.fps; }
   std::string describe() const override { return "V4L2 camera " + settings_.path; }
+  Nanos shutter_time() const override { return exposure_; }  // exposure_absolute (0: not known)
 
   const V4l2Format& format() const { return format_; }
   const V4l2Stats& stats() const { return stats_; }

@@ -53,8 +53,9 @@ CameraIntrinsics live_camera(const LiveInputOptions& o, int width, int height);
 // identity with --latency-ms. InputError naming the file when it cannot be read.
 tracking::Rig live_rig(const std::string& session_json, double latency_ms);
 
-// session.json content for a recording of these inputs (camera, tracker, rig).
+// session.json content for a recording of these inputs (camera, tracker, rig, and the
+// source's shutter time as radiometry.shutter_s when it says it: 0 when not).
 nlohmann::json live_session(const LiveInputOptions& o, const CameraIntrinsics& camera,
-                            const tracking::TrackerDriver* driver);
+                            const tracking::TrackerDriver* driver, Nanos shutter_time);
 
 }  // namespace lumar::pipeline

@@ -32,6 +32,7 @@ struct LiveLoopSettings {
   capture::QueuePolicy policy = capture::QueuePolicy::KeepNewest;
   std::size_t queue_frames = 1;
   Nanos max_wait = 40'000'000;                         // longest a frame waits for the tracker to cover its time
+  Nanos shutter = 0;  // motion blur: ... to cover its shutter's end, half this past its time
   int max_frames = 0;                                  // stop after this many frames (0: no limit)
   Nanos duration = 0;                                  // stop this long after the start (0: no limit)
   bool drain_on_stop = false;                          // when stopped, frames already captured are handed on too
@@ -66,6 +67,10 @@ class LiveLoop {
   void use_recorded_poses(std::shared_ptr<const capture::RecordingReplay> recording);
   void on_samples(SampleObserver observer) { observer_ = std::move(observer); }
 
+  // The camera at time t, near a frame's time (another instant of its shutter), from
+  // the same poses the frame was paired with: the tracker's, or the recording's.
+  std::optional<Pose> camera_at(const capture::Frame& frame, Nanos t) const;
+
   // Starts the tracker and waits until its first pose arrives, so that no frame is
   // captured before poses flow. InputError naming the tracker after `timeout`.
   void wait_for_tracker(Nanos timeout, const std::string& tracker_name);
@@ -95,7 +100,8 @@ class LiveLoop {
  private:
   void take_samples();
   void report_tracker_state();
-  std::optional<Pose> recorded_pose(const capture::Frame& frame) const;
+  // At the recorded time of the frame + offset.
+  std::optional<Pose> recorded_pose(const capture::Frame& frame, Nanos offset = 0) const;
   capture::PairedFrame pair(capture::Frame frame);
   void count(const capture::PairedFrame& paired);
 

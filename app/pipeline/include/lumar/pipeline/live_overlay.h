@@ -74,7 +74,8 @@ class LiveOverlay {
  private:
   // Keeps `frame` as a probe if a choice is asked for, and makes the choice once there
   // are enough; true when it did.
-  bool probe(const capture::Frame& frame, const std::optional<Pose>& pose);
+  bool probe(const capture::Frame& frame, const std::optional<Pose>& pose,
+             const std::vector<std::optional<Pose>>& shutter_cameras);
 
   std::optional<QualityBudget> probe_budget_;
   std::vector<ProbeFrame> probes_;

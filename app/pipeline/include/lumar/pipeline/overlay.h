@@ -4,6 +4,7 @@
 // (response, vignetting, exposure: how the camera turned radiance into codes), the
 // lighting adaptation, and the time each stage took.
 #include <chrono>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <span>
@@ -118,6 +119,13 @@ class Overlay {
   // shutter centred on the frame's time; empty when the shutter time is 0 or the motion
   // blur is off.
   std::vector<Nanos> shutter_times(Nanos frame_time) const;
+  // The camera at each of shutter_times(frame_time): the frame's `pose` (the tracker's,
+  // or the tracker's fixed by the video) moved by the tracker's own motion from the
+  // frame's time to each instant, `tracked_at(t)` being the tracker's camera at t; so a
+  // correction by the video holds over the whole shutter. The frame's own time gets
+  // `pose` bit for bit. Empty without a pose or without motion blur.
+  std::vector<std::optional<Pose>> shutter_cameras(Nanos frame_time, const std::optional<Pose>& pose,
+                                                   const std::function<std::optional<Pose>(Nanos)>& tracked_at) const;
   double shutter_s() const { return shutter_s_; }
   // Only the first step of composite(): the animated objects where their paths are then.
   void play_paths(Nanos frame_time);

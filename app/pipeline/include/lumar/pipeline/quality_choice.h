@@ -56,6 +56,9 @@ struct QualityChoice {
 struct ProbeFrame {
   capture::Frame frame;
   Pose T_world_camera;
+  // The camera over the frame's shutter (Overlay::shutter_cameras), so that the trials
+  // pay for the motion blur as the run will; empty without it.
+  std::vector<std::optional<Pose>> shutter_cameras;
 };
 
 // Tries settings on `frames` (at least two) from the overlay's current quality, its full
