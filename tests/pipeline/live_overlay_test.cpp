@@ -16,6 +16,8 @@
 #include "lumar/calib/camera_file.h"
 #include "lumar/capture/recording_replay.h"
 #include "lumar/capture/session.h"
+#include "lumar/pipeline/live_inputs.h"
+#include "lumar/pipeline/live_loop.h"
 #include "lumar/pipeline/live_overlay.h"
 #include "lumar/pipeline/registration_error.h"
 #include "lumar/pipeline/replay_overlay.h"
@@ -263,6 +265,52 @@ TEST(LiveOverlay, BlursTheObjectsOverTheShutterAsTheReplayDoes) {
   EXPECT_GE(worst_psnr_blurred, 45.0);
   EXPECT_GT(moved[0], 100 * frames);
   EXPECT_LT(moved[1], moved[0] / 20);
+}
+
+// With motion blur a live frame waits until the tracker's samples pass its shutter's end,
+// so that the camera at the shutter's last instant is interpolated, not extrapolated;
+// without, only its middle. The recording played as a camera, the emulator on a pty.
+TEST(LiveLoop, WithAShutterAFrameWaitsForTheTrackerToPassItsEnd) {
+  const std::filesystem::path& dir = still_recording();
+  const capture::RecordingReplay replay(dir);
+  constexpr Nanos kShutter = 200'000'000;
+  // covered: the tracker had passed the shutter's end; posed_at_end: the camera there was
+  // known (the pose stream refuses to extrapolate that far, and the frame gets no blur).
+  int frames[2] = {0, 0}, covered[2] = {0, 0}, posed_at_end[2] = {0, 0};
+  for (const int blur : {0, 1}) {
+    tracking::EmulatorSettings e = emulator_for(replay);
+    e.device_latency = 0;
+    tracking::TrackerEmulator emulator(e);
+    pipeline::LiveInputOptions in;
+    in.source = "recording:" + dir.string();
+    in.tracker = "serial:" + emulator.port_path();
+    pipeline::LiveLoopSettings settings;
+    settings.max_wait = 2 * kShutter;
+    settings.max_frames = 12;
+    settings.shutter = blur ? kShutter : 0;
+    pipeline::LiveLoop loop(pipeline::open_live_source(in).source, pipeline::make_tracker_driver(in, {}),
+                            tracking::Rig{}, settings);
+    Nanos newest = 0;  // the newest sample's measurement time the loop has taken
+    loop.on_samples([&](const std::vector<tracking::PoseSample>& samples) {
+      for (const auto& s : samples) newest = std::max(newest, s.time);
+    });
+    loop.wait_for_tracker(5 * kNanosPerSecond, "emulator");
+    loop.run([&](capture::PairedFrame& paired) {
+      ++frames[blur];
+      if (newest >= paired.frame.time + kShutter / 2) ++covered[blur];
+      if (loop.camera_at(paired.frame, paired.frame.time + kShutter / 2)) ++posed_at_end[blur];
+      return true;
+    });
+  }
+  std::printf(
+      "frames whose shutter's end the tracker had passed: %d of %d waiting for it, %d of %d not; the camera "
+      "there known for %d and %d\n",
+      covered[1], frames[1], covered[0], frames[0], posed_at_end[1], posed_at_end[0]);
+  EXPECT_GE(frames[1], kFewestLiveFrames);
+  EXPECT_GE(frames[0], kFewestLiveFrames);
+  EXPECT_EQ(covered[1], frames[1]);
+  EXPECT_EQ(posed_at_end[1], frames[1]);
+  EXPECT_LE(covered[0], frames[0] / 2);
 }
 
 // Live, with the tracker's usual noise (0.75 deg, 2.5 mm RMS): the video steadies it as on
