@@ -5,11 +5,8 @@
 
 namespace lumar::capture {
 
-RecordingSource::RecordingSource(const RecordingReader& recording)
-    : dir_(recording.directory()),
-      video_(recording.video()),
-      frames_(recording.frames()),
-      shutter_(seconds_to_nanos(recording.session().radiometry.shutter_s)) {}
+RecordingSource::RecordingSource(const RecordingReader& recording, Nanos shutter_time)
+    : dir_(recording.directory()), video_(recording.video()), frames_(recording.frames()), shutter_(shutter_time) {}
 
 void RecordingSource::fail_truncated() const {
   throw InputError(segment_file_.string() + ": truncated or corrupt video (decoded " + std::to_string(decoded_) +

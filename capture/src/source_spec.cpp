@@ -1,7 +1,10 @@
 #include "lumar/capture/source_spec.h"
 
+#include <memory>
+
 #include "lumar/capture/image_sequence_source.h"
 #include "lumar/capture/recording_reader.h"
+#include "lumar/capture/recording_source.h"
 #include "lumar/capture/video_file_source.h"
 
 namespace lumar::capture {
@@ -16,7 +19,12 @@ OpenedSource open_frame_source(const std::string& spec, const SourceOptions& opt
   if (kind == "video") return {std::make_unique<VideoFileSource>(path), false};
   if (kind == "images")
     return {std::make_unique<ImageSequenceSource>(ImageSequenceSettings{path, options.timestamps, options.fps}), false};
-  if (kind == "recording") return {RecordingReader(path).open_frames(), false};
+  if (kind == "recording") {
+    // Played as a camera, it says its session's shutter time, as a camera its exposure time.
+    const RecordingReader recording(path);
+    return {std::make_unique<RecordingSource>(recording, seconds_to_nanos(recording.session().radiometry.shutter_s)),
+            false};
+  }
   if (kind == "v4l2") {
     V4l2Settings s = options.v4l2;
     s.path = path;

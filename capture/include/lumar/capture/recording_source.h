@@ -14,7 +14,9 @@ class RecordingReader;
 
 class RecordingSource : public FrameSource {
  public:
-  explicit RecordingSource(const RecordingReader& recording);
+  // `shutter_time`: what shutter_time() says (0: not known); a recording played as a
+  // camera says its session's (open_frame_source).
+  explicit RecordingSource(const RecordingReader& recording, Nanos shutter_time = 0);
 
   // InputError "<segment path>: truncated or corrupt video (decoded K of N frames)"
   // when a segment fails to open or yields fewer frames than frames.csv lists.
@@ -22,7 +24,7 @@ class RecordingSource : public FrameSource {
   cv::Size frame_size() const override { return video_.size; }
   double nominal_fps() const override { return video_.fps; }
   std::string describe() const override { return "recording " + dir_.string(); }
-  Nanos shutter_time() const override { return shutter_; }  // the session's radiometry.shutter_s
+  Nanos shutter_time() const override { return shutter_; }
 
  private:
   void open_segment(int segment);
