@@ -80,12 +80,16 @@ tracking::Rig live_rig(const std::string& session_json, double latency_ms) {
   return capture::load_session_file(session_json).rig;
 }
 
+double source_shutter_s(const capture::FrameSource& source) {
+  return std::min(1.0, nanos_to_seconds(source.shutter_time()));
+}
+
 nlohmann::json live_session(const LiveInputOptions& o, const CameraIntrinsics& camera,
-                            const tracking::TrackerDriver* driver, Nanos shutter_time) {
+                            const tracking::TrackerDriver* driver, double shutter_s) {
   capture::Session s;
   s.camera = camera;
   // The overlay blurs the objects' motion over it (docs/ground_truth.md, "Motion blur").
-  s.radiometry.shutter_s = std::min(1.0, nanos_to_seconds(shutter_time));
+  s.radiometry.shutter_s = shutter_s;
   s.rig.latency = seconds_to_nanos(o.latency_ms * 1e-3);
   if (driver) {
     const auto& f = driver->settings().format;

@@ -2,7 +2,6 @@
 
 #include <spdlog/spdlog.h>
 
-#include <algorithm>
 #include <chrono>
 
 #include "lumar/base/error.h"
@@ -48,8 +47,7 @@ LiveOverlay::LiveOverlay(const LiveOverlayOptions& o) {
   if (!(radiometry.exposure > 0)) throw InputError("--exposure must be a positive number");
   // The camera's own exposure time, where it says it, is the shutter the motion blur
   // spans (--shutter overrides it); else the session's.
-  if (const Nanos shutter = live.source->shutter_time(); shutter > 0)
-    radiometry.shutter_s = std::min(1.0, nanos_to_seconds(shutter));
+  if (const double shutter_s = source_shutter_s(*live.source); shutter_s > 0) radiometry.shutter_s = shutter_s;
 
   tracking::Rig rig = session ? session->rig : tracking::Rig{};
   rig.latency = seconds_to_nanos(in.latency_ms * 1e-3);

@@ -36,7 +36,7 @@ void record_live(const RecordOptions& o) {
 
   LiveSource live = open_live_source(o.in);
   const cv::Size size = live.source->frame_size();
-  const Nanos shutter_time = live.source->shutter_time();
+  const double shutter_s = source_shutter_s(*live.source);
   double fps = live.source->nominal_fps();
   if (!(fps > 0)) fps = 30;
   const CameraIntrinsics camera = live_camera(o.in, size.width, size.height);
@@ -59,7 +59,7 @@ void record_live(const RecordOptions& o) {
   video.fps = fps;
   video.size = size;
   video.frames_per_segment = std::max(1, int(std::lround(fps * o.segment_seconds)));
-  capture::RecordingWriter writer(o.out, live_session(o.in, camera, driver.get(), shutter_time), video);
+  capture::RecordingWriter writer(o.out, live_session(o.in, camera, driver.get(), shutter_s), video);
 
   LiveLoopSettings settings;
   settings.what = "record";

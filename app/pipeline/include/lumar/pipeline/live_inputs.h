@@ -53,9 +53,13 @@ CameraIntrinsics live_camera(const LiveInputOptions& o, int width, int height);
 // identity with --latency-ms. InputError naming the file when it cannot be read.
 tracking::Rig live_rig(const std::string& session_json, double latency_ms);
 
+// A source's shutter time as a session's radiometry.shutter_s, held to its 1 s bound
+// (0: the source does not say).
+double source_shutter_s(const capture::FrameSource& source);
+
 // session.json content for a recording of these inputs (camera, tracker, rig, and the
-// source's shutter time as radiometry.shutter_s when it says it: 0 when not).
+// shutter time, source_shutter_s).
 nlohmann::json live_session(const LiveInputOptions& o, const CameraIntrinsics& camera,
-                            const tracking::TrackerDriver* driver, Nanos shutter_time);
+                            const tracking::TrackerDriver* driver, double shutter_s);
 
 }  // namespace lumar::pipeline
