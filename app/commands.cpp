@@ -22,7 +22,7 @@ void add_composite_options(CLI::App* cmd, CompositeOptions& o) {
   cmd->add_option(
       "--without", o.without,
       "Switch off what makes the objects look like the camera's pixels: a comma-separated list of "
-      "antialiasing, self-occlusion, noise, blur, bounce, lines (the shadows' radiosity lines; without them, "
+      "antialiasing, self-occlusion, noise, blur, chroma (the codec's chroma subsampling), bounce, lines (the shadows' radiosity lines; without them, "
       "the 2004 system's bounding-sphere shadows), contact (the dense receivers where an object touches the floor), "
       "motion-blur (the objects drawn over the shutter's time), or all (docs/ground_truth.md)");
   cmd->add_option("--blur-sigma", o.blur_sigma_px,
@@ -88,13 +88,15 @@ void apply_composite_options(const CompositeOptions& o, pipeline::OverlaySetting
       f.lines = false;
     else if (name == "contact")
       f.contact = false;
+    else if (name == "chroma")
+      f.chroma = false;
     else if (name == "motion-blur")
       f.motion_blur = false;
     else if (name == "all")
-      f = gl::CompositeFeatures{false, false, false, false, false, false, false, false};
+      f = gl::CompositeFeatures::none();
     else
       throw InputError("--without " + without + ": unknown feature '" + name +
-                       "'; use antialiasing, self-occlusion, noise, blur, bounce, lines, contact, motion-blur or all");
+                       "'; use antialiasing, self-occlusion, noise, blur, chroma, bounce, lines, contact, motion-blur or all");
   }
   if (o.blur_sigma_px >= 0) settings.blur_sigma_px = o.blur_sigma_px;
   if (o.shutter_s != -1.0) {

@@ -97,7 +97,7 @@ int main() {
   for (int bits = -1; bits < 16; ++bits) {
     pipeline::ReplayOverlaySettings settings;
     if (bits < 0)
-      settings.overlay.features = gl::CompositeFeatures{false, false, false, false, false, false, false, false};
+      settings.overlay.features = gl::CompositeFeatures::none();
     else
       settings.overlay.features = {bool(bits & 1), bool(bits & 2), bool(bits & 4), bool(bits & 8)};
     const std::string name = bits < 0 ? k2004 : name_of(settings.overlay.features);

@@ -28,6 +28,7 @@ void RecordingSource::open_segment(int segment) {
   const int api = cv::CAP_FFMPEG;
   std::error_code ec;
   if (!std::filesystem::exists(segment_file_, ec) || !capture_.open(segment_file_.string(), api)) fail_truncated();
+  chroma_ = chroma_sampling_of(capture_);
 }
 
 bool RecordingSource::read(Frame& frame) {
@@ -46,6 +47,7 @@ bool RecordingSource::read(Frame& frame) {
                      std::to_string(video_.size.width) + "x" + std::to_string(video_.size.height) +
                      " BGR; the recording is damaged");
   frame.image = image;
+  frame.chroma = chroma_;
   frame.time = entry.time;
   frame.index = entry.index;
   ++next_;

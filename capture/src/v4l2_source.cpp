@@ -245,7 +245,7 @@ void V4l2Source::stop_streaming() noexcept {
   fd_ = -1;
 }
 
-bool V4l2Source::convert(const Buffer& buffer, std::size_t bytes_used, cv::Mat& bgr) {
+bool V4l2Source::convert(const Buffer& buffer, std::size_t bytes_used, cv::Mat& bgr, ChromaSampling& chroma) {
   const int w = format_.width, h = format_.height;
   const auto* data = static_cast<std::uint8_t*>(buffer.start);
   bytes_used = std::min(bytes_used, buffer.length);
@@ -254,6 +254,7 @@ bool V4l2Source::convert(const Buffer& buffer, std::size_t bytes_used, cv::Mat& 
     if (bytes_used == 0) return false;
     cv::Mat encoded(1, int(bytes_used), CV_8UC1, const_cast<std::uint8_t*>(data));
     bgr = cv::imdecode(encoded, cv::IMREAD_COLOR);
+    chroma = chroma_sampling_of_jpeg({data, bytes_used});
     return !bgr.empty() && bgr.cols == w && bgr.rows == h;
   }
   const int channels = f == "YUYV" ? 2 : 3;
@@ -261,6 +262,7 @@ bool V4l2Source::convert(const Buffer& buffer, std::size_t bytes_used, cv::Mat& 
       format_.bytes_per_line > 0 ? std::size_t(format_.bytes_per_line) : std::size_t(w) * channels;
   if (stride < std::size_t(w) * channels || bytes_used < stride * std::size_t(h)) return false;
   const cv::Mat raw(h, w, channels == 2 ? CV_8UC2 : CV_8UC3, const_cast<std::uint8_t*>(data), stride);
+  chroma = f == "YUYV" ? ChromaSampling{2, 1} : ChromaSampling{};
   if (f == "YUYV")
     cv::cvtColor(raw, bgr, cv::COLOR_YUV2BGR_YUYV);
   else if (f == "RGB3")
@@ -318,7 +320,8 @@ bool V4l2Source::read(Frame& frame) {
     last_sequence_ = seq;
 
     cv::Mat bgr;
-    const bool good = !(b.flags & V4L2_BUF_FLAG_ERROR) && convert(buffers_[b.index], b.bytesused, bgr);
+    ChromaSampling chroma;
+    const bool good = !(b.flags & V4L2_BUF_FLAG_ERROR) && convert(buffers_[b.index], b.bytesused, bgr, chroma);
     // The buffer goes back at once, whatever happened to its contents.
     if (xioctl(*device_, fd_, VIDIOC_QBUF, &b) < 0) fail_errno("VIDIOC_QBUF");
     if (!good) {
@@ -343,6 +346,7 @@ bool V4l2Source::read(Frame& frame) {
     t = std::max(t, last_time_ + 1);  // a FrameSource's times increase
     last_time_ = t;
     frame.image = bgr;
+    frame.chroma = chroma;
     frame.time = t;
     frame.index = seq + index_offset_;
     ++stats_.frames;

@@ -19,6 +19,7 @@ VideoFileSource::VideoFileSource(const std::filesystem::path& path) : path_(path
                      " format (e.g. H.264 MP4 or MJPEG AVI)");
   const double fps = capture_.get(cv::CAP_PROP_FPS);
   fps_ = std::isfinite(fps) && fps > 0 ? fps : 0;
+  chroma_ = chroma_sampling_of(capture_);
   if (!decode(first_)) throw InputError(path.string() + ": no decodable video frame; the file is empty or corrupt");
   first_pending_ = true;
   size_ = first_.image.size();
@@ -32,6 +33,7 @@ bool VideoFileSource::decode(Frame& frame) {
   if (image.channels() == 1) cv::cvtColor(image, image, cv::COLOR_GRAY2BGR);
   if (image.channels() == 4) cv::cvtColor(image, image, cv::COLOR_BGRA2BGR);
   frame.image = image;
+  frame.chroma = chroma_;
   frame.time = Nanos(std::llround(capture_.get(cv::CAP_PROP_POS_MSEC) * 1e6));
   const std::int64_t slot = fps_ > 0 ? std::llround(nanos_to_seconds(frame.time) * fps_) : 0;
   frame.index = std::max(slot, next_index_);

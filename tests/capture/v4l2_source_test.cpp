@@ -170,6 +170,7 @@ TEST(V4l2Source, StreamsYuyvFramesWithMidExposureKernelTimes) {
         for (int c = 0; c < 3; ++c) worst = std::max(worst, std::abs(int(got[c]) - int(want[c])));
       }
     EXPECT_LE(worst, 2) << "frame " << k;  // OpenCV's fixed-point BT.601 vs the formula
+    EXPECT_EQ(f.chroma, (ChromaSampling{2, 1})) << "YUYV: one chroma sample per two pixels of a row";
   }
   const V4l2Stats& st = r.source->stats();
   EXPECT_EQ(st.frames, 6u);
@@ -197,6 +198,7 @@ TEST(V4l2Source, DecodesMjpegFrames) {
     // Exactly the JPEG's pixels (only bytesused bytes of the buffer were decoded), and
     // close to the picture that was encoded, unlike the other frames.
     EXPECT_EQ(cv::norm(f.image, decoded[std::size_t(k)], cv::NORM_INF), 0.0);
+    EXPECT_EQ(f.chroma, (ChromaSampling{2, 2})) << "the JPEG's own header: libjpeg's 4:2:0";
     EXPECT_LT(test::mean_abs_diff(f.image, originals[std::size_t(k)]), 5.0);
     for (int other = 0; other < 3; ++other)
       if (other != k) {

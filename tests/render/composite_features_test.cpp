@@ -9,9 +9,12 @@
 #include <cmath>
 #include <glm/gtc/matrix_transform.hpp>
 #include <numbers>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include "lumar/base/constants.h"
 #include "lumar/base/error.h"
+#include "lumar/capture/chroma_sampling.h"
 #include "lumar/lighting/irradiance_volume.h"
 #include "lumar/lighting/room_radiance.h"
 #include "lumar/render/renderer.h"
@@ -20,7 +23,7 @@
 namespace lumar::test {
 namespace {
 
-constexpr gl::CompositeFeatures kNone{false, false, false, false, false, false, false, false};
+constexpr gl::CompositeFeatures kNone = gl::CompositeFeatures::none();
 
 // A camera looking down -z at a quad of `half` half-width at z = -2, lit to linear `value`.
 struct FlatObject {
@@ -256,6 +259,78 @@ TEST(CompositeFeatures, MotionBlurIsTheMeanOfTheShuttersInstants) {
   std::vector<gl::ShutterInstant> wrong = moving_object;
   wrong[2].T_world_model.clear();
   EXPECT_THROW(flat.renderer->render_overlay(black, flat.pose, 1.0, nullptr, wrong), InputError);
+}
+
+// Luma (JFIF's) of 8-bit BGR, in code values.
+cv::Mat luma_of(const cv::Mat& bgr8) {
+  cv::Mat f, y;
+  bgr8.convertTo(f, CV_32FC3);
+  cv::transform(f, y, cv::Matx13f(0.114f, 0.587f, 0.299f));
+  return y;
+}
+
+TEST(CompositeFeatures, ChromaIsSubsampledAsTheCamerasCodecDoes) {
+  headless_context();
+  // A red quad on a green video, its edges on pixel boundaries (x 40|41 and 118|119), each
+  // 2×2 chroma block at its left edge half red, half green.
+  FlatObject flat(0.5f, 0.52f);
+  flat.renderer->set_object_material(flat.id, glm::vec3(1.0f, 0.12f, 0.08f), uniform_sh(0.5f));
+  const cv::Mat video(120, 160, CV_8UC3, cv::Scalar(50, 150, 60));
+  flat.renderer->set_features({.antialiasing = false, .self_occlusion = false, .noise = false, .blur = false});
+  const cv::Mat plain = flat.renderer->render_overlay(video, flat.pose, 1.0);
+  gl::VideoRadiometry radiometry;
+  radiometry.chroma_horizontal = radiometry.chroma_vertical = 2;
+  flat.renderer->set_video_radiometry(radiometry);
+  const cv::Mat subsampled = flat.renderer->render_overlay(video, flat.pose, 1.0);
+
+  // The reference: libjpeg itself (OpenCV's JPEG codec, 4:2:0, quality 100) on the plain composite.
+  std::vector<std::uint8_t> bytes;
+  cv::imencode(".jpg", plain, bytes, {cv::IMWRITE_JPEG_QUALITY, 100});
+  ASSERT_EQ(capture::chroma_sampling_of_jpeg(bytes), (capture::ChromaSampling{2, 2}));
+  const cv::Mat jpeg = cv::imdecode(bytes, cv::IMREAD_COLOR);
+  const cv::Mat mask = flat.renderer->render_object_mask(flat.pose);
+  cv::Mat near;  // within 3 px of the quad's outline, where chroma mixes
+  cv::dilate(mask, near, cv::getStructuringElement(cv::MORPH_RECT, cv::Size(7, 7)));
+  cv::Mat inner;
+  cv::erode(mask, inner, cv::getStructuringElement(cv::MORPH_RECT, cv::Size(7, 7)));
+  near &= ~inner;
+  double worst = 0, worst_plain = 0;
+  for (int r = 0; r < 120; ++r)
+    for (int c = 0; c < 160; ++c) {
+      if (!near.at<std::uint8_t>(r, c)) continue;
+      for (int k = 0; k < 3; ++k) {
+        const double j = jpeg.at<cv::Vec3b>(r, c)[k];
+        worst = std::max(worst, std::abs(subsampled.at<cv::Vec3b>(r, c)[k] - j));
+        worst_plain = std::max(worst_plain, std::abs(plain.at<cv::Vec3b>(r, c)[k] - j));
+      }
+    }
+  std::printf("chroma 4:2:0 at the outline: worst |composite - libjpeg| %.0f levels, without it %.0f\n", worst,
+              worst_plain);
+  EXPECT_LE(worst, 4.0) << "the codec's chroma, within its own rounding";
+  EXPECT_GT(worst_plain, 40.0) << "the plain composite's outline is far from the codec's";
+  // Each pixel keeps its own luma; far from the quad the video is untouched.
+  EXPECT_LT(cv::norm(luma_of(subsampled), luma_of(plain), cv::NORM_INF), 1.01);
+  cv::Mat far;
+  cv::dilate(mask, far, cv::getStructuringElement(cv::MORPH_RECT, cv::Size(9, 9)));
+  EXPECT_EQ(cv::norm(subsampled, plain, cv::NORM_INF, ~far), 0.0);
+  EXPECT_EQ(cv::norm(subsampled, video, cv::NORM_INF, ~far), 0.0);
+
+  // 4:2:2 (YUYV) mixes along rows only: the row above the quad keeps the video's colour.
+  radiometry.chroma_vertical = 1;
+  flat.renderer->set_video_radiometry(radiometry);
+  const cv::Mat rows_only = flat.renderer->render_overlay(video, flat.pose, 1.0);
+  const cv::Rect above(60, 20, 40, 1);  // the quad's top edge lies between rows 20 and 21
+  ASSERT_EQ(cv::countNonZero(mask(above + cv::Point(0, 1))), 40);
+  EXPECT_EQ(cv::norm(rows_only(above), video(above), cv::NORM_INF), 0.0);
+  EXPECT_GT(cv::norm(subsampled(above), video(above), cv::NORM_INF), 20.0);
+  EXPECT_GT(cv::norm(rows_only.row(60).colRange(38, 42), plain.row(60).colRange(38, 42), cv::NORM_INF), 20.0);
+
+  // Switched off: the plain composite.
+  flat.renderer->set_features({.antialiasing = false, .self_occlusion = false, .noise = false, .blur = false,
+                               .chroma = false});
+  EXPECT_EQ(cv::norm(flat.renderer->render_overlay(video, flat.pose, 1.0), plain, cv::NORM_INF), 0.0);
+  radiometry.chroma_horizontal = 3;
+  EXPECT_THROW(flat.renderer->set_video_radiometry(radiometry), InputError);
 }
 
 }  // namespace

@@ -73,12 +73,14 @@ cv::Mat CompositeErrorMeter::linear(const cv::Mat& bgr8) const {
 namespace {
 
 // Dark specks: pixels inside the mask (with their eight neighbours) below a quarter of
-// the median of their 3×3 neighbourhood in the green channel, at full resolution, where
-// the truth's pixel is not one: what a ray into a hole of an open scan makes.
+// the median of their 3×3 neighbourhood in luminance, at full resolution, where the
+// truth's pixel is not one: what a ray into a hole of an open scan makes. Luminance, not
+// one channel: a codec that shares chroma among pixels (4:2:0) moves a single channel of
+// a pixel with its neighbours' colour, but keeps each pixel's own luma.
 std::int64_t count_specks(const cv::Mat& composite, const cv::Mat& truth, const cv::Mat& mask) {
   const auto dark = [](const cv::Mat& linear) {
     cv::Mat g, median;
-    cv::extractChannel(linear, g, 1);
+    cv::transform(linear, g, cv::Matx13f(0.0722f, 0.7152f, 0.2126f));  // B, G, R: Rec. 709's luminance
     cv::medianBlur(g, median, 3);
     return g < 0.25 * median;
   };

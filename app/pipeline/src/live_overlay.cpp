@@ -96,7 +96,7 @@ bool LiveOverlay::probe(const capture::Frame& frame, const std::optional<Pose>& 
                         const std::vector<std::optional<Pose>>& shutter_cameras) {
   if (!probe_budget_ || !pose) return false;
   if (!probes_.empty() && nanos_to_seconds(frame.time - probes_.back().frame.time) < kProbeSpacingS) return false;
-  probes_.push_back({{frame.image.clone(), frame.time, frame.index}, *pose, shutter_cameras});  // the source reuses its buffer
+  probes_.push_back({{frame.image.clone(), frame.time, frame.index, frame.chroma}, *pose, shutter_cameras});  // the source reuses its buffer
   if (int(probes_.size()) < probe_budget_->frames + 1) return false;
   const QualityBudget budget = *probe_budget_;
   probe_budget_.reset();

@@ -72,7 +72,7 @@ std::vector<ProbeFrame> ReplayOverlay::probe_frames(int count) {
   for (std::size_t i = 0; int(out.size()) < count && frames->read(frame); ++i) {
     if (i * std::size_t(count) < out.size() * total) continue;  // before the next one's place
     if (const std::optional<Pose> pose = camera_pose(frame))  // a source may reuse its buffer
-      out.push_back({{frame.image.clone(), frame.time, frame.index}, *pose, shutter_cameras(frame, pose)});
+      out.push_back({{frame.image.clone(), frame.time, frame.index, frame.chroma}, *pose, shutter_cameras(frame, pose)});
   }
   return out;
 }

@@ -476,6 +476,7 @@ class OverlayUi {
     dirty_ |= ImGui::Checkbox("bounce (objects light the room)", &features_.bounce);
     ImGui::SameLine();
     dirty_ |= ImGui::Checkbox("contact shadows", &features_.contact);
+    dirty_ |= ImGui::Checkbox("chroma subsampling (the camera's codec)", &features_.chroma);
     if (overlay_.shutter_s() > 0)  // the recording says how long its shutter was open
       dirty_ |= ImGui::Checkbox(fmt::format("motion blur ({:.0f} ms shutter)", 1e3 * overlay_.shutter_s()).c_str(),
                                 &features_.motion_blur);

@@ -191,6 +191,7 @@ struct Renderer::Impl {
   CameraIntrinsics video_camera;                               // the distorted camera the vignetting is defined on
   glm::vec3 noise_read_variance{0.0f}, noise_shot_gain{0.0f};  // RGB
   float blur_sigma = 0.0f;
+  glm::ivec2 chroma_block{1, 1};  // pixels per chroma sample (VideoRadiometry's)
   CompositeFeatures features;
   float coverage_error_px = 0.0f;
   std::uint32_t frame_number = 0;  // seeds the noise: a new draw every frame
@@ -685,6 +686,10 @@ void Renderer::set_video_radiometry(const VideoRadiometry& radiometry) {
   }
   if (!std::isfinite(radiometry.blur_sigma_px) || radiometry.blur_sigma_px < 0 || radiometry.blur_sigma_px > 4)
     throw InputError("Renderer::set_video_radiometry: blur sigma must be between 0 and 4 pixels");
+  for (const int block : {radiometry.chroma_horizontal, radiometry.chroma_vertical})
+    if (block != 1 && block != 2)
+      throw InputError("Renderer::set_video_radiometry: " + std::to_string(block) +
+                       " pixels per chroma sample; the codecs it follows share one among 1 or 2 each way");
   r.vignetting = glm::vec2(float(radiometry.vignetting_a), float(radiometry.vignetting_b));
   r.video_camera = radiometry.video_camera;
   for (int c = 0; c < 3; ++c) {  // BGR -> RGB
@@ -692,6 +697,7 @@ void Renderer::set_video_radiometry(const VideoRadiometry& radiometry) {
     r.noise_shot_gain[c] = radiometry.noise_shot_gain[std::size_t(2 - c)];
   }
   r.blur_sigma = float(radiometry.blur_sigma_px);
+  r.chroma_block = glm::ivec2(radiometry.chroma_horizontal, radiometry.chroma_vertical);
   if (radiometry.linear_of_code.empty()) {
     r.response_decode = GlName();
     r.response_encode = GlName();
@@ -788,8 +794,10 @@ cv::Mat Renderer::render_overlay(const cv::Mat& video_bgr8, const std::optional<
   // Antialiasing and blur change `scene` in place, only within the objects' footprint.
   const bool antialiasing = r.features.antialiasing && r.multisampled.samples > 1;
   const bool blur = r.features.blur && r.blur_sigma > 0.0f;
+  const bool chroma = r.features.chroma && r.chroma_block != glm::ivec2(1);
   const glm::mat4 vp = T_world_camera ? Impl::view_projection(r.camera, *T_world_camera) : glm::mat4(1.0f);
-  const cv::Rect footprint = T_world_camera && (antialiasing || blur) ? r.objects_footprint(vp) : cv::Rect();
+  const cv::Rect footprint =
+      T_world_camera && (antialiasing || blur || chroma) ? r.objects_footprint(vp) : cv::Rect();
   if (T_world_camera && antialiasing) {
     r.antialias(vp, footprint, *T_world_camera);
     clock.mark(&t.antialiasing_ms);
@@ -825,6 +833,13 @@ cv::Mat Renderer::render_overlay(const cv::Mat& video_bgr8, const std::optional<
   glProgramUniform3fv(enc, uniform(enc, "noise_read_variance"), 1, glm::value_ptr(r.noise_read_variance));
   glProgramUniform3fv(enc, uniform(enc, "noise_shot_gain"), 1, glm::value_ptr(r.noise_shot_gain));
   glProgramUniform1ui(enc, uniform(enc, "noise_seed"), r.frame_number++);
+  // Chroma mixes a pixel with neighbours up to 3 px away (2 before it, 3 after): only
+  // there can a rendered pixel change what the video shows.
+  const cv::Rect mixed =
+      chroma && T_world_camera ? r.grown(Impl::bounding(footprint, moving), 3) : cv::Rect();
+  glProgramUniform2i(enc, uniform(enc, "chroma_block"), mixed.empty() ? 1 : r.chroma_block.x,
+                     mixed.empty() ? 1 : r.chroma_block.y);
+  glProgramUniform4i(enc, uniform(enc, "chroma_region"), mixed.x, mixed.y, mixed.br().x, mixed.br().y);
   r.draw_fullscreen();
   cv::Mat out(r.camera.height, r.camera.width, CV_8UC3);
   glPixelStorei(GL_PACK_ALIGNMENT, 1);

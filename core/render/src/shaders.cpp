@@ -176,6 +176,11 @@ uniform vec2 vignetting;         // (a, b): gain 1 + a r^2 + b r^4
 uniform bool use_noise;
 uniform vec3 noise_read_variance, noise_shot_gain;  // the sensor's: variance = read + gain * linear
 uniform uint noise_seed;         // a new one every frame
+// The codec's chroma subsampling, within chroma_region (linear_image's texels, rows bottom
+// up, x0 y0 x1 y1, the ends excluded), where rendered pixels lie: pixels per chroma sample,
+// 1 or 2 each way.
+uniform ivec2 chroma_block;
+uniform ivec4 chroma_region;
 out vec4 color;
 
 // A 32-bit integer hash (Wellons' "lowbias32"): the noise's random numbers, per pixel and frame.
@@ -199,32 +204,86 @@ vec3 linear_to_srgb(vec3 v) {
   return mix(v * 12.92, 1.055 * pow(v, vec3(1.0 / 2.4)) - 0.055, greaterThan(v, vec3(0.0031308)));
 }
 
-void main() {
-  // Written upside down so that glReadPixels returns the top row first.
+// Linear light to the camera's code over 255, through its response.
+vec3 encoded(vec3 linear) {
+  if (!use_response_lut) return linear_to_srgb(linear);
+  vec3 s = sqrt(clamp(linear / lut_max, 0.0, 1.0));
+  float n = float(textureSize(response_encode, 0).x);
+  vec3 x = (s * (n - 1.0) + 0.5) / n;
+  return vec3(texture(response_encode, vec2(x.r, 0.5)).r, texture(response_encode, vec2(x.g, 0.5)).g,
+              texture(response_encode, vec2(x.b, 0.5)).b);
+}
+
+// The linear light the sensor saw at OpenCV pixel q (clamped to the image), in alpha its
+// rendered share.
+// Rendered pixels (alpha 1) fall off towards the corners as the camera's own pixels did;
+// video pixels (alpha 0) already have the camera's vignetting.
+vec4 exposed(ivec2 q) {
   ivec2 size = textureSize(linear_image, 0);
-  ivec2 p = ivec2(gl_FragCoord.xy);
-  p.y = size.y - 1 - p.y;
-  vec4 v = texelFetch(linear_image, p, 0);
-  // Rendered pixels (alpha 1) fall off towards the corners as the camera's own pixels
-  // did; video pixels (alpha 0) already have the camera's vignetting.
-  vec2 pixel = floor(gl_FragCoord.xy);  // the output's OpenCV pixel (its rows are flipped on read-back)
+  q = clamp(q, ivec2(0), size - 1);
+  vec4 v = texelFetch(linear_image, ivec2(q.x, size.y - 1 - q.y), 0);  // the image's rows are upside down
   // Vignetting belongs to the camera's own pixels: where this one came from in the video.
-  if (use_undistortion_map) pixel = texelFetch(undistortion_map, ivec2(pixel), 0).xy;
+  vec2 pixel = vec2(q);
+  if (use_undistortion_map) pixel = texelFetch(undistortion_map, q, 0).xy;
   float r2 = dot(pixel - principal_point, pixel - principal_point) / (half_diagonal * half_diagonal);
   vec3 linear = v.rgb * mix(1.0, 1.0 + vignetting.x * r2 + vignetting.y * r2 * r2, v.a);
   // The sensor's noise on what was rendered, in proportion to its share of the pixel
-  // (the video's own pixels have theirs).
+  // (the video's own pixels have theirs): before the codec, as in the camera.
   if (use_noise && v.a > 0.0)
-    linear += v.a * noise_gaussian(p) * sqrt(noise_read_variance + noise_shot_gain * max(linear, vec3(0.0)));
-  if (use_response_lut) {
-    vec3 s = sqrt(clamp(linear / lut_max, 0.0, 1.0));
-    float n = float(textureSize(response_encode, 0).x);
-    vec3 x = (s * (n - 1.0) + 0.5) / n;
-    color = vec4(texture(response_encode, vec2(x.r, 0.5)).r, texture(response_encode, vec2(x.g, 0.5)).g,
-                 texture(response_encode, vec2(x.b, 0.5)).b, 1.0);
+    linear += v.a * noise_gaussian(ivec2(q.x, size.y - 1 - q.y)) *
+              sqrt(noise_read_variance + noise_shot_gain * max(linear, vec3(0.0)));
+  return vec4(linear, v.a);
+}
+
+// The weights of the pixels a decoder's chroma at coordinate c mixes, along one axis, from
+// `first` on: each chroma sample the mean of its `block` pixels, then interpolated between
+// the samples' centres as libjpeg's "fancy" upsampling does (3/4 the own, 1/4 the nearer
+// neighbour's).
+void chroma_taps(int c, int block, out int first, out vec4 w) {
+  if (block == 1) {
+    first = c, w = vec4(1.0, 0.0, 0.0, 0.0);
+  } else if ((c & 1) == 0) {
+    first = c - 2, w = vec4(1.0, 1.0, 3.0, 3.0) / 8.0;
   } else {
-    color = vec4(linear_to_srgb(linear), 1.0);
+    first = c - 1, w = vec4(3.0, 3.0, 1.0, 1.0) / 8.0;
   }
+}
+
+void main() {
+  ivec2 size = textureSize(linear_image, 0);
+  // Written upside down so that glReadPixels returns the top row first: the output's
+  // OpenCV pixel is the fragment's.
+  ivec2 q = ivec2(gl_FragCoord.xy);
+  vec4 v = exposed(q);
+  vec3 linear = v.rgb;
+  ivec2 texel = ivec2(q.x, size.y - 1 - q.y);
+  if (chroma_block != ivec2(1) && all(greaterThanEqual(texel, chroma_region.xy)) &&
+      all(lessThan(texel, chroma_region.zw))) {
+    // The camera's codec keeps each pixel's luma and the chroma of its neighbourhood: a
+    // rendered pixel's colour bleeds into the video around it, and the video's into it.
+    ivec2 first;
+    vec4 wx, wy;
+    chroma_taps(q.x, chroma_block.x, first.x, wx);
+    chroma_taps(q.y, chroma_block.y, first.y, wy);
+    vec3 mixed = vec3(0.0);
+    float rendered = 0.0;
+    for (int j = 0; j < 4; ++j)
+      for (int i = 0; i < 4; ++i) {
+        float w = wx[i] * wy[j];
+        if (w == 0.0) continue;
+        vec4 t = exposed(first + ivec2(i, j));
+        mixed += w * encoded(t.rgb);
+        rendered += t.a;
+      }
+    if (rendered > 0.0) {
+      // The mixed colour's chroma with this pixel's luma: a grey added changes luma only.
+      const vec3 luma = vec3(0.299, 0.587, 0.114);  // JFIF's, of R, G, B
+      vec3 own = encoded(linear);
+      color = vec4(clamp(mixed + dot(own - mixed, luma), 0.0, 1.0), 1.0);
+      return;
+    }
+  }
+  color = vec4(encoded(linear), 1.0);
 }
 )glsl";
 

@@ -41,6 +41,7 @@ class RecordingSource : public FrameSource {
   std::filesystem::path segment_file_;
   int segment_rows_ = 0;  // frames.csv rows for it
   int decoded_ = 0;       // frames decoded from it so far
+  ChromaSampling chroma_;  // its decoder's pixel format's
 };
 
 }  // namespace lumar::capture

@@ -97,7 +97,8 @@ class V4l2Source final : public FrameSource {
   void set_controls();
   void start_streaming();
   void stop_streaming() noexcept;
-  bool convert(const Buffer& buffer, std::size_t bytes_used, cv::Mat& bgr);
+  // The frame's image, and its chroma sampling: YUYV's 2×1, an MJPEG frame's own header's.
+  bool convert(const Buffer& buffer, std::size_t bytes_used, cv::Mat& bgr, ChromaSampling& chroma);
   [[noreturn]] void vanished();
 
   V4l2Settings settings_;

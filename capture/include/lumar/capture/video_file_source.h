@@ -32,6 +32,7 @@ class VideoFileSource : public FrameSource {
   cv::Size size_;
   double fps_ = 0;
   std::int64_t next_index_ = 0;  // lowest index the next frame may have
+  ChromaSampling chroma_;        // the decoder's pixel format's
   Frame first_;                  // decoded in the constructor to prove the file decodes
   bool first_pending_ = false;
 };

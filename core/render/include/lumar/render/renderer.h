@@ -52,6 +52,9 @@ struct VideoRadiometry {
   std::array<float, 3> noise_read_variance{}, noise_shot_gain{};
   // The camera's blur (lens, sensor, resampling) as a Gaussian, output pixels.
   double blur_sigma_px = 0.0;
+  // How many pixels share one chroma sample in the camera's or codec's YCbCr, along x and
+  // y (1 or 2 each): 2×2 for 4:2:0 (JPEG, H.264), 2×1 for 4:2:2 (YUYV), 1×1 for none.
+  int chroma_horizontal = 1, chroma_vertical = 1;
 };
 
 // What makes rendered pixels look like the camera's own around them (docs/ground_truth.md,
@@ -61,6 +64,7 @@ struct CompositeFeatures {
   bool self_occlusion = true;  // the objects' baked occlusion of themselves
   bool noise = true;           // VideoRadiometry's noise on rendered pixels
   bool blur = true;            // VideoRadiometry's blur on rendered pixels and their edges
+  bool chroma = true;          // VideoRadiometry's chroma subsampling on rendered pixels and their edges
   bool bounce = true;          // the objects' light reflected onto the receivers (the Compositor's)
   // The objects' shadows on the room from the radiosity lines (the Compositor's); off:
   // the 2004 system's, one line per bright patch against each object's bounding sphere.
@@ -71,6 +75,9 @@ struct CompositeFeatures {
   // The objects drawn at several instants of the shutter and averaged, when the frame
   // gives them (render_overlay's `shutter`): their motion blur against the camera.
   bool motion_blur = true;
+
+  // Every feature off: the 2004 system's look, the measuring baseline.
+  static constexpr CompositeFeatures none() { return {false, false, false, false, false, false, false, false, false}; }
 };
 
 // One instant while the camera's shutter was open: where the camera and each object
