@@ -357,8 +357,11 @@ void Overlay::measure_clipping(const cv::Mat& composite, const Pose& T_world_cam
   const cv::Mat mask = compositor_->renderer().render_object_mask(T_world_camera);
   const int covered = cv::countNonZero(mask);
   if (covered == 0 || mask.size() != composite.size()) return;
-  cv::Mat white;
-  cv::inRange(composite, cv::Scalar(254, 254, 254), cv::Scalar(255, 255, 255), white);
+  // White in luma (JFIF's): the codec's chroma (4:2:0) gives a clipped pixel by the outline
+  // some of its neighbours' colour, but keeps its luma.
+  cv::Mat luma;
+  cv::transform(composite, luma, cv::Matx13f(0.114f, 0.587f, 0.299f));  // B, G, R
+  const cv::Mat white = luma >= 253.5f;
   objects_clipped_ = double(cv::countNonZero(white & mask)) / covered;
   if (*objects_clipped_ > kClipWarnShare && !clip_warned_) {
     clip_warned_ = true;

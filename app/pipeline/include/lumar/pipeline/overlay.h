@@ -180,7 +180,7 @@ class Overlay {
   std::optional<std::chrono::steady_clock::time_point> first_composite_time() const { return first_composite_; }
   const StageTimes& times() const { return times_; }
   int frames_without_pose() const { return frames_without_pose_; }
-  // The share of the objects' pixels that clip to white in every channel, measured on the
+  // The share of the objects' pixels that clip to white (in luma), measured on the
   // first frame with a pose and every kClipCheckEvery frames after it (nullopt before).
   // Over kClipWarnShare a warning says so, once: the objects are brighter than the camera
   // records at this exposure (under a sun, say); whether a real object would clip too, a
