@@ -833,6 +833,7 @@ cv::Mat Renderer::render_overlay(const cv::Mat& video_bgr8, const std::optional<
   glProgramUniform3fv(enc, uniform(enc, "noise_read_variance"), 1, glm::value_ptr(r.noise_read_variance));
   glProgramUniform3fv(enc, uniform(enc, "noise_shot_gain"), 1, glm::value_ptr(r.noise_shot_gain));
   glProgramUniform1ui(enc, uniform(enc, "noise_seed"), r.frame_number++);
+  glBindTextureUnit(shaders::kResponseDecodeUnit, r.response_decode.get());
   // Chroma mixes a pixel with neighbours up to 3 px away (2 before it, 3 after): only
   // there can a rendered pixel change what the video shows.
   const cv::Rect mixed =

@@ -176,6 +176,7 @@ uniform vec2 vignetting;         // (a, b): gain 1 + a r^2 + b r^4
 uniform bool use_noise;
 uniform vec3 noise_read_variance, noise_shot_gain;  // the sensor's: variance = read + gain * linear
 uniform uint noise_seed;         // a new one every frame
+layout(binding = 4) uniform sampler2D response_decode;  // 256 x 1 RGB: linear value of each code
 // The codec's chroma subsampling, within chroma_region (linear_image's texels, rows bottom
 // up, x0 y0 x1 y1, the ends excluded), where rendered pixels lie: pixels per chroma sample,
 // 1 or 2 each way.
@@ -204,7 +205,11 @@ vec3 linear_to_srgb(vec3 v) {
   return mix(v * 12.92, 1.055 * pow(v, vec3(1.0 / 2.4)) - 0.055, greaterThan(v, vec3(0.0031308)));
 }
 
-// Linear light to the camera's code over 255, through its response.
+vec3 srgb_to_linear(vec3 v) {
+  return mix(v / 12.92, pow((v + 0.055) / 1.055, vec3(2.4)), greaterThan(v, vec3(0.04045)));
+}
+
+// Linear light to the camera's code over 255, through its response, and back.
 vec3 encoded(vec3 linear) {
   if (!use_response_lut) return linear_to_srgb(linear);
   vec3 s = sqrt(clamp(linear / lut_max, 0.0, 1.0));
@@ -213,9 +218,14 @@ vec3 encoded(vec3 linear) {
   return vec3(texture(response_encode, vec2(x.r, 0.5)).r, texture(response_encode, vec2(x.g, 0.5)).g,
               texture(response_encode, vec2(x.b, 0.5)).b);
 }
+vec3 decoded(vec3 code) {
+  if (!use_response_lut) return srgb_to_linear(code);
+  vec3 x = (clamp(code, 0.0, 1.0) * 255.0 + 0.5) / 256.0;
+  return vec3(texture(response_decode, vec2(x.r, 0.5)).r, texture(response_decode, vec2(x.g, 0.5)).g,
+              texture(response_decode, vec2(x.b, 0.5)).b);
+}
 
-// The linear light the sensor saw at OpenCV pixel q (clamped to the image), in alpha its
-// rendered share.
+// The linear light at OpenCV pixel q (clamped to the image), in alpha its rendered share.
 // Rendered pixels (alpha 1) fall off towards the corners as the camera's own pixels did;
 // video pixels (alpha 0) already have the camera's vignetting.
 vec4 exposed(ivec2 q) {
@@ -226,13 +236,7 @@ vec4 exposed(ivec2 q) {
   vec2 pixel = vec2(q);
   if (use_undistortion_map) pixel = texelFetch(undistortion_map, q, 0).xy;
   float r2 = dot(pixel - principal_point, pixel - principal_point) / (half_diagonal * half_diagonal);
-  vec3 linear = v.rgb * mix(1.0, 1.0 + vignetting.x * r2 + vignetting.y * r2 * r2, v.a);
-  // The sensor's noise on what was rendered, in proportion to its share of the pixel
-  // (the video's own pixels have theirs): before the codec, as in the camera.
-  if (use_noise && v.a > 0.0)
-    linear += v.a * noise_gaussian(ivec2(q.x, size.y - 1 - q.y)) *
-              sqrt(noise_read_variance + noise_shot_gain * max(linear, vec3(0.0)));
-  return vec4(linear, v.a);
+  return vec4(v.rgb * mix(1.0, 1.0 + vignetting.x * r2 + vignetting.y * r2 * r2, v.a), v.a);
 }
 
 // The weights of the pixels a decoder's chroma at coordinate c mixes, along one axis, from
@@ -279,10 +283,15 @@ void main() {
       // The mixed colour's chroma with this pixel's luma: a grey added changes luma only.
       const vec3 luma = vec3(0.299, 0.587, 0.114);  // JFIF's, of R, G, B
       vec3 own = encoded(linear);
-      color = vec4(clamp(mixed + dot(own - mixed, luma), 0.0, 1.0), 1.0);
-      return;
+      linear = decoded(clamp(mixed + dot(own - mixed, luma), 0.0, 1.0));
     }
   }
+  // The sensor's noise on what was rendered, in proportion to its share of the pixel (the
+  // video's own pixels have theirs). After the codec: its level was measured on the
+  // footage the codec had already smoothed.
+  if (use_noise && v.a > 0.0)
+    linear += v.a * noise_gaussian(ivec2(q.x, size.y - 1 - q.y)) *
+              sqrt(noise_read_variance + noise_shot_gain * max(linear, vec3(0.0)));
   color = vec4(encoded(linear), 1.0);
 }
 )glsl";
