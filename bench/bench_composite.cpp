@@ -1,8 +1,8 @@
 // The composite against its ground truth for every combination of the features that make
 // rendered pixels look like the camera's (antialiasing, self-occlusion, noise, blur:
 // docs/ground_truth.md): each region's error against milliseconds per frame, through the
-// pipeline library `lumar regress` runs, the bounce and the shadow lines on. Baseline, in
-// the same run: the 2004 system's look (no antialiasing, no self-occlusion, no noise or
+// pipeline library `lumar regress` runs, the bounce, the shadow lines and the codec's
+// chroma on. Baseline, in the same run: the 2004 system's look (no antialiasing, no self-occlusion, no noise or
 // blur, no bounce, bounding-sphere shadows: `--without all`). Writes
 // docs/composite_error_vs_cost.png (object, edge and shadow, one above the other) and
 // docs/composite_before_after_truth.png (crops at the figurine's feet: the 2004 look,
@@ -92,8 +92,8 @@ int main() {
     reports[std::size_t(k)].highlight = "aa+occlusion+noise+blur";
   }
   cv::Mat before, after, truth, mask;
-  // bits 0-15: the four features' combinations (bounce and the shadow lines on); -1: the
-  // 2004 system (every feature off, bounce off, the bounding-sphere shadows).
+  // bits 0-15: the four features' combinations (bounce, the shadow lines and the chroma
+  // on); -1: the 2004 system (every feature off, bounce off, the bounding-sphere shadows).
   for (int bits = -1; bits < 16; ++bits) {
     pipeline::ReplayOverlaySettings settings;
     if (bits < 0)

@@ -269,17 +269,20 @@ void main() {
     vec4 wx, wy;
     chroma_taps(q.x, chroma_block.x, first.x, wx);
     chroma_taps(q.y, chroma_block.y, first.y, wy);
-    vec3 mixed = vec3(0.0);
+    // Only where a rendered pixel is among those mixed (most of the region is video).
     float rendered = 0.0;
     for (int j = 0; j < 4; ++j)
       for (int i = 0; i < 4; ++i) {
-        float w = wx[i] * wy[j];
-        if (w == 0.0) continue;
-        vec4 t = exposed(first + ivec2(i, j));
-        mixed += w * encoded(t.rgb);
-        rendered += t.a;
+        ivec2 t = clamp(first + ivec2(i, j), ivec2(0), size - 1);
+        if (wx[i] * wy[j] > 0.0) rendered += texelFetch(linear_image, ivec2(t.x, size.y - 1 - t.y), 0).a;
       }
     if (rendered > 0.0) {
+      vec3 mixed = vec3(0.0);
+      for (int j = 0; j < 4; ++j)
+        for (int i = 0; i < 4; ++i) {
+          float w = wx[i] * wy[j];
+          if (w > 0.0) mixed += w * encoded(exposed(first + ivec2(i, j)).rgb);
+        }
       // The mixed colour's chroma with this pixel's luma: a grey added changes luma only.
       const vec3 luma = vec3(0.299, 0.587, 0.114);  // JFIF's, of R, G, B
       vec3 own = encoded(linear);
@@ -290,8 +293,7 @@ void main() {
   // video's own pixels have theirs). After the codec: its level was measured on the
   // footage the codec had already smoothed.
   if (use_noise && v.a > 0.0)
-    linear += v.a * noise_gaussian(ivec2(q.x, size.y - 1 - q.y)) *
-              sqrt(noise_read_variance + noise_shot_gain * max(linear, vec3(0.0)));
+    linear += v.a * noise_gaussian(texel) * sqrt(noise_read_variance + noise_shot_gain * max(linear, vec3(0.0)));
   color = vec4(encoded(linear), 1.0);
 }
 )glsl";
