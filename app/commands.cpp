@@ -95,8 +95,9 @@ void apply_composite_options(const CompositeOptions& o, pipeline::OverlaySetting
     else if (name == "all")
       f = gl::CompositeFeatures::none();
     else
-      throw InputError("--without " + without + ": unknown feature '" + name +
-                       "'; use antialiasing, self-occlusion, noise, blur, chroma, bounce, lines, contact, motion-blur or all");
+      throw InputError(
+          "--without " + without + ": unknown feature '" + name +
+          "'; use antialiasing, self-occlusion, noise, blur, chroma, bounce, lines, contact, motion-blur or all");
   }
   if (o.blur_sigma_px >= 0) settings.blur_sigma_px = o.blur_sigma_px;
   if (o.shutter_s != -1.0) {

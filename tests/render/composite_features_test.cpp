@@ -339,8 +339,8 @@ TEST(CompositeFeatures, ChromaIsSubsampledAsTheCamerasCodecDoes) {
   EXPECT_GT(cv::norm(rows_only.row(60).colRange(38, 42), plain.row(60).colRange(38, 42), cv::NORM_INF), 20.0);
 
   // Switched off: the plain composite.
-  flat.renderer->set_features({.antialiasing = false, .self_occlusion = false, .noise = false, .blur = false,
-                               .chroma = false});
+  flat.renderer->set_features(
+      {.antialiasing = false, .self_occlusion = false, .noise = false, .blur = false, .chroma = false});
   EXPECT_EQ(cv::norm(flat.renderer->render_overlay(video, flat.pose, 1.0), plain, cv::NORM_INF), 0.0);
   radiometry.chroma_horizontal = 3;
   EXPECT_THROW(flat.renderer->set_video_radiometry(radiometry), InputError);

@@ -283,8 +283,8 @@ OverlayFrame Overlay::begin(const capture::Frame& frame, const std::optional<Pos
   // each with its own context: draw in this one's.
   context_->make_current();
   // The codec's chroma sampling comes with the frames (a camera may switch formats).
-  if (const auto block = frame.chroma; block.horizontal != radiometry_.chroma_horizontal ||
-                                       block.vertical != radiometry_.chroma_vertical) {
+  if (const auto block = frame.chroma;
+      block.horizontal != radiometry_.chroma_horizontal || block.vertical != radiometry_.chroma_vertical) {
     // The renderer follows 1 or 2 each way; a coarser codec (4:1:1) is taken as the nearest it follows.
     radiometry_.chroma_horizontal = std::clamp(block.horizontal, 1, 2);
     radiometry_.chroma_vertical = std::clamp(block.vertical, 1, 2);

@@ -79,7 +79,7 @@ void write_synthetic_recording(const std::filesystem::path& out, const capture::
       if (dropped && dropped(k)) continue;
       const Nanos t = frame_time(k);
       const Pose T_world_camera = true_camera(t);
-      writer.add_frame(capture::Frame{render(k, t, T_world_camera, rng), t, k, {}});
+      writer.add_frame(capture::Frame{render(k, t, T_world_camera, rng), t, k});
       writer.add_truth(k, t, T_world_camera);
       if ((k + 1) % std::max(1, frames / 4) == 0 || k + 1 == frames) spdlog::info("synth: frame {}/{}", k + 1, frames);
     }

@@ -796,8 +796,7 @@ cv::Mat Renderer::render_overlay(const cv::Mat& video_bgr8, const std::optional<
   const bool blur = r.features.blur && r.blur_sigma > 0.0f;
   const bool chroma = r.features.chroma && r.chroma_block != glm::ivec2(1);
   const glm::mat4 vp = T_world_camera ? Impl::view_projection(r.camera, *T_world_camera) : glm::mat4(1.0f);
-  const cv::Rect footprint =
-      T_world_camera && (antialiasing || blur || chroma) ? r.objects_footprint(vp) : cv::Rect();
+  const cv::Rect footprint = T_world_camera && (antialiasing || blur || chroma) ? r.objects_footprint(vp) : cv::Rect();
   if (T_world_camera && antialiasing) {
     r.antialias(vp, footprint, *T_world_camera);
     clock.mark(&t.antialiasing_ms);
@@ -836,8 +835,7 @@ cv::Mat Renderer::render_overlay(const cv::Mat& video_bgr8, const std::optional<
   glBindTextureUnit(shaders::kResponseDecodeUnit, r.response_decode.get());
   // Chroma mixes a pixel with neighbours up to 3 px away (2 before it, 3 after): only
   // there can a rendered pixel change what the video shows.
-  const cv::Rect mixed =
-      chroma && T_world_camera ? r.grown(Impl::bounding(footprint, moving), 3) : cv::Rect();
+  const cv::Rect mixed = chroma && T_world_camera ? r.grown(Impl::bounding(footprint, moving), 3) : cv::Rect();
   glProgramUniform2i(enc, uniform(enc, "chroma_block"), mixed.empty() ? 1 : r.chroma_block.x,
                      mixed.empty() ? 1 : r.chroma_block.y);
   glProgramUniform4i(enc, uniform(enc, "chroma_region"), mixed.x, mixed.y, mixed.br().x, mixed.br().y);

@@ -11,10 +11,10 @@
 namespace lumar::capture {
 
 struct Frame {
-  cv::Mat image;           // 8-bit BGR, as the camera delivered it (distorted, display-encoded)
-  Nanos time = 0;          // middle of the exposure; recordings: since the recording's start
-  std::int64_t index = 0;  // frame number at the source (gaps mean dropped frames)
-  ChromaSampling chroma;   // how the camera or codec sampled its colour (1×1: each pixel its own, or not known)
+  cv::Mat image;            // 8-bit BGR, as the camera delivered it (distorted, display-encoded)
+  Nanos time = 0;           // middle of the exposure; recordings: since the recording's start
+  std::int64_t index = 0;   // frame number at the source (gaps mean dropped frames)
+  ChromaSampling chroma{};  // how the camera or codec sampled its colour (1×1: each pixel its own, or not known)
 };
 
 class FrameSource {
