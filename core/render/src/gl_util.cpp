@@ -105,6 +105,14 @@ GlName create_vertex_array() {
   return GlName(id, delete_vertex_array);
 }
 
+std::string with_glsl_library(const char* source, const char* library) {
+  std::string s(source);
+  const std::size_t version = s.find("#version");
+  const std::size_t line_end = version == std::string::npos ? std::string::npos : s.find('\n', version);
+  if (line_end == std::string::npos) throw RuntimeError("OpenGL: a shader has no #version line (a bug in lumar)");
+  return s.insert(line_end + 1, library);
+}
+
 GlName create_program(const char* name, const char* vertex_source, const char* fragment_source) {
   GlName vs = compile_shader(name, GL_VERTEX_SHADER, vertex_source);
   GlName fs = compile_shader(name, GL_FRAGMENT_SHADER, fragment_source);

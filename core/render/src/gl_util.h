@@ -4,6 +4,7 @@
 #include <epoxy/gl.h>
 
 #include <opencv2/core.hpp>
+#include <string>
 #include <utility>
 
 namespace lumar::gl {
@@ -52,6 +53,9 @@ void attach_float_attribute(GLuint vertex_array, GLuint attribute, GLuint buffer
 // Compiles and links a program; throws RuntimeError naming `name` with the driver's
 // log (on one line) when compiling or linking fails.
 GlName create_program(const char* name, const char* vertex_source, const char* fragment_source);
+// `source` with the GLSL functions of `library` (no #version line of its own) inserted
+// after its #version line, so that its code may use them.
+std::string with_glsl_library(const char* source, const char* library);
 
 // True when an EGL or GLX context is current on this thread (GL calls without one abort).
 bool any_context_current();

@@ -511,13 +511,15 @@ Renderer::Renderer(const CameraIntrinsics& camera) : impl_(std::make_unique<Impl
   r.camera = camera.without_distortion();
   r.empty_vertex_array = create_vertex_array();
   using namespace shaders;
-  r.background = create_program("background", kFullscreenVertex, kBackgroundFragment);
+  r.background = create_program("background", kFullscreenVertex,
+                                with_glsl_library(kBackgroundFragment, kCameraResponseGlsl).c_str());
   r.depth_only = create_program("proxy depth", kMeshVertex, kDepthOnlyFragment);
   r.shaded_object = create_program("shaded object", kMeshVertex,
                                    (std::string(kShadedObjectFragment) + kIrradianceVolumeGlsl).c_str());
   r.world_position = create_program("world position", kMeshVertex, kWorldPositionFragment);
   r.room_radiance = create_program("room radiance", kMeshVertex, kRoomRadianceFragment);
-  r.encode = create_program("sRGB encode", kFullscreenVertex, kEncodeFragment);
+  r.encode =
+      create_program("sRGB encode", kFullscreenVertex, with_glsl_library(kEncodeFragment, kCameraResponseGlsl).c_str());
   r.blur = create_program("camera blur", kFullscreenVertex, kBlurFragment);
   r.covered = create_program("object coverage", kMeshVertex, kCoveredFragment);
   r.antialias_resolve = create_program("antialiasing", kFullscreenVertex, kAntialiasFragment);

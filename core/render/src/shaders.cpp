@@ -11,6 +11,25 @@ void main() {
 }
 )glsl";
 
+const char* const kCameraResponseGlsl = R"glsl(
+// The camera's response, from its code to linear light: one table for every pass that
+// decodes codes (the video, and the encode pass's chroma).
+layout(binding = 4) uniform sampler2D response_decode;  // 256 x 1 RGB: linear value of each code
+uniform bool use_response_lut;  // false: the default sRGB response
+
+vec3 srgb_to_linear(vec3 v) {
+  return mix(v / 12.92, pow((v + 0.055) / 1.055, vec3(2.4)), greaterThan(v, vec3(0.04045)));
+}
+
+// The linear value of code / 255: linear interpolation between the table's entries.
+vec3 decoded(vec3 code) {
+  if (!use_response_lut) return srgb_to_linear(code);
+  vec3 x = (clamp(code, 0.0, 1.0) * 255.0 + 0.5) / 256.0;
+  return vec3(texture(response_decode, vec2(x.r, 0.5)).r, texture(response_decode, vec2(x.g, 0.5)).g,
+              texture(response_decode, vec2(x.b, 0.5)).b);
+}
+)glsl";
+
 const char* const kMeshVertex = R"glsl(
 #version 450 core
 layout(location = 0) in vec3 position;
@@ -49,15 +68,9 @@ const char* const kBackgroundFragment = R"glsl(
 #version 450 core
 layout(binding = 0) uniform sampler2D video;           // texel row 0 = top row of the frame
 layout(binding = 1) uniform sampler2D undistortion_map; // RG32F, output size, row 0 = top
-layout(binding = 4) uniform sampler2D response_decode;  // 256 x 1 RGB: linear value of each code
 uniform bool use_undistortion_map;
-uniform bool use_response_lut;  // false: the default sRGB response
 uniform vec2 output_size;
 out vec4 color;
-
-vec3 srgb_to_linear(vec3 v) {
-  return mix(v / 12.92, pow((v + 0.055) / 1.055, vec3(2.4)), greaterThan(v, vec3(0.04045)));
-}
 
 void main() {
   vec2 uv;
@@ -71,15 +84,7 @@ void main() {
   }
   // Filter the encoded values, as cv::remap does, then decode. Alpha 0 marks video
   // pixels: the encode pass vignettes only what was rendered.
-  vec3 code = texture(video, uv).rgb;
-  if (use_response_lut) {
-    // Linear interpolation between the table's entries at code * 255.
-    vec3 x = (code * 255.0 + 0.5) / 256.0;
-    color = vec4(texture(response_decode, vec2(x.r, 0.5)).r, texture(response_decode, vec2(x.g, 0.5)).g,
-                 texture(response_decode, vec2(x.b, 0.5)).b, 0.0);
-  } else {
-    color = vec4(srgb_to_linear(code), 0.0);
-  }
+  color = vec4(decoded(texture(video, uv).rgb), 0.0);
 }
 )glsl";
 
@@ -167,7 +172,6 @@ const char* const kEncodeFragment = R"glsl(
 layout(binding = 3) uniform sampler2D linear_image;
 layout(binding = 1) uniform sampler2D undistortion_map; // RG32F, output size, row 0 = top
 layout(binding = 5) uniform sampler2D response_encode;  // N x 1 RGB: code / 255 at linear = s^2 * lut_max
-uniform bool use_response_lut;
 uniform bool use_undistortion_map;
 uniform vec3 lut_max;            // linear value of code 255, per channel
 uniform vec2 principal_point;    // OpenCV pixels of the video's (distorted) camera
@@ -176,7 +180,6 @@ uniform vec2 vignetting;         // (a, b): gain 1 + a r^2 + b r^4
 uniform bool use_noise;
 uniform vec3 noise_read_variance, noise_shot_gain;  // the sensor's: variance = read + gain * linear
 uniform uint noise_seed;         // a new one every frame
-layout(binding = 4) uniform sampler2D response_decode;  // 256 x 1 RGB: linear value of each code
 // The codec's chroma subsampling, within chroma_region (linear_image's texels, rows bottom
 // up, x0 y0 x1 y1, the ends excluded), where rendered pixels lie: pixels per chroma sample,
 // 1 or 2 each way.
@@ -205,11 +208,7 @@ vec3 linear_to_srgb(vec3 v) {
   return mix(v * 12.92, 1.055 * pow(v, vec3(1.0 / 2.4)) - 0.055, greaterThan(v, vec3(0.0031308)));
 }
 
-vec3 srgb_to_linear(vec3 v) {
-  return mix(v / 12.92, pow((v + 0.055) / 1.055, vec3(2.4)), greaterThan(v, vec3(0.04045)));
-}
-
-// Linear light to the camera's code over 255, through its response, and back.
+// Linear light to the camera's code over 255, through its response (back: decoded()).
 vec3 encoded(vec3 linear) {
   if (!use_response_lut) return linear_to_srgb(linear);
   vec3 s = sqrt(clamp(linear / lut_max, 0.0, 1.0));
@@ -217,12 +216,6 @@ vec3 encoded(vec3 linear) {
   vec3 x = (s * (n - 1.0) + 0.5) / n;
   return vec3(texture(response_encode, vec2(x.r, 0.5)).r, texture(response_encode, vec2(x.g, 0.5)).g,
               texture(response_encode, vec2(x.b, 0.5)).b);
-}
-vec3 decoded(vec3 code) {
-  if (!use_response_lut) return srgb_to_linear(code);
-  vec3 x = (clamp(code, 0.0, 1.0) * 255.0 + 0.5) / 256.0;
-  return vec3(texture(response_decode, vec2(x.r, 0.5)).r, texture(response_decode, vec2(x.g, 0.5)).g,
-              texture(response_decode, vec2(x.b, 0.5)).b);
 }
 
 // The linear light at OpenCV pixel q (clamped to the image), in alpha its rendered share.

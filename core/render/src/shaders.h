@@ -7,13 +7,16 @@ namespace lumar::gl::shaders {
 extern const char* const kFullscreenVertex;  // one triangle covering the viewport
 extern const char* const kMeshVertex;        // model -> world -> clip; world position and normal out
 
+// Functions shared by fragment stages, inserted after their #version line (with_glsl_library).
+extern const char* const kCameraResponseGlsl;  // decoded(code): the response's table, or sRGB
+
 // Fragment stages.
-extern const char* const kBackgroundFragment;     // undistorted video, decoded to linear
+extern const char* const kBackgroundFragment;     // undistorted video, decoded to linear (+ kCameraResponseGlsl)
 extern const char* const kDepthOnlyFragment;      // proxy room as occluder
 extern const char* const kShadedObjectFragment;   // albedo * E(n) / pi * exposure, E from SH9 or the irradiance volume
 extern const char* const kWorldPositionFragment;  // (x, y, z, 1)
 extern const char* const kRoomRadianceFragment;   // environment map projected from its capture point
-extern const char* const kEncodeFragment;         // linear -> sRGB, rows flipped for read-back; the camera's noise
+extern const char* const kEncodeFragment;         // linear -> sRGB, rows flipped for read-back; the camera's noise (+ kCameraResponseGlsl)
 extern const char* const kBlurFragment;           // one pass of the camera's blur on rendered pixels
 extern const char* const kCoveredFragment;        // 1: where an object is (its coverage, multisampled)
 extern const char* const kAntialiasFragment;      // outline pixels mixed by the objects' coverage
