@@ -6,6 +6,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <set>
+#include <span>
 
 #include "lumar/base/csv.h"
 #include "lumar/base/error.h"
@@ -78,16 +79,24 @@ ImageSequenceSource::ImageSequenceSource(ImageSequenceSettings settings) : setti
   size_ = decode(0).size();
 }
 
-cv::Mat ImageSequenceSource::decode(std::size_t i) const {
-  cv::Mat img = cv::imread(files_[i].string(), cv::IMREAD_COLOR);  // BGR8, whatever the file holds
+cv::Mat ImageSequenceSource::decode(std::size_t i, ChromaSampling* chroma) const {
+  // Read once: the decoder and, for a JPEG, its frame header's chroma sampling.
+  const std::string bytes = read_input_file(files_[i], "image");
+  const std::span<const std::uint8_t> data(reinterpret_cast<const std::uint8_t*>(bytes.data()), bytes.size());
+  cv::Mat img;
+  if (!bytes.empty())  // BGR8, whatever the file holds
+    img = cv::imdecode(cv::Mat(1, int(bytes.size()), CV_8UC1, const_cast<char*>(bytes.data())), cv::IMREAD_COLOR);
   if (img.empty()) throw InputError(files_[i].string() + ": cannot decode this image; it is corrupt or not an image");
+  // Other formats hold no chroma samples of their own (PNG, BMP, TIFF and PPM store RGB).
+  if (chroma) *chroma = chroma_sampling_of_jpeg(data);
   return img;
 }
 
 bool ImageSequenceSource::read(Frame& frame) {
   if (next_ >= files_.size()) return false;
   const std::size_t i = next_++;  // a bad file is reported once, then skipped
-  cv::Mat img = decode(i);
+  ChromaSampling chroma;
+  cv::Mat img = decode(i, &chroma);
   if (img.size() != size_)
     throw InputError(files_[i].string() + ": is " + std::to_string(img.cols) + "x" + std::to_string(img.rows) +
                      ", the sequence started at " + std::to_string(size_.width) + "x" + std::to_string(size_.height) +
@@ -95,6 +104,7 @@ bool ImageSequenceSource::read(Frame& frame) {
   frame.image = img;
   frame.time = times_[i];
   frame.index = std::int64_t(i);
+  frame.chroma = chroma;
   return true;
 }
 

@@ -1,10 +1,13 @@
 // How sources say their colour was sampled (capture::ChromaSampling): from a JPEG's frame
-// header, from the decoder's pixel format of real files, and per frame from each source.
+// header, from the decoder's pixel format of real files, and per frame from each source
+// (an image sequence's JPEG files each from their own header).
 #include <gtest/gtest.h>
 
+#include <fstream>
 #include <opencv2/imgcodecs.hpp>
 
 #include "lumar/capture/chroma_sampling.h"
+#include "lumar/capture/image_sequence_source.h"
 #include "lumar/capture/recording_reader.h"
 #include "lumar/capture/video_file_source.h"
 #include "test_paths.h"
@@ -72,6 +75,33 @@ TEST(ChromaSampling, FramesCarryTheirSourcesSampling) {
     ASSERT_TRUE(frames->read(f));
     EXPECT_EQ(f.chroma, (ChromaSampling{2, 2})) << "frame " << k;
   }
+}
+
+TEST(ChromaSampling, ImageSequencesTakeEachJpegsOwn) {
+  const test::Scratch scratch("chroma_image_sequence");
+  cv::Mat image(48, 64, CV_8UC3);
+  cv::randu(image, cv::Scalar::all(0), cv::Scalar::all(255));
+  std::vector<std::uint8_t> jpeg;
+  cv::imencode(".jpg", image, jpeg, {cv::IMWRITE_JPEG_QUALITY, 90});
+  const auto write = [&](const char* name, const std::vector<std::uint8_t>& bytes) {
+    std::ofstream(scratch.dir / name, std::ios::binary)
+        .write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size()));
+  };
+  write("frame-1.jpg", jpeg);  // libjpeg's 4:2:0
+  cv::imwrite((scratch.dir / "frame-2.png").string(), image);
+  jpeg[luma_sampling_at(jpeg)] = 0x21;  // the same picture's header made 4:2:2
+  write("frame-3.JPEG", jpeg);
+  ImageSequenceSource source({scratch.dir.string(), {}, 10.0});
+  const std::vector<ChromaSampling> expected{{2, 2}, {1, 1}, {2, 1}};
+  Frame f;
+  for (std::size_t k = 0; k < expected.size(); ++k) {
+    ASSERT_TRUE(source.read(f));
+    EXPECT_EQ(f.chroma, expected[k]) << source.files()[k];
+    // Decoded as cv::imread decodes the file.
+    EXPECT_EQ(cv::norm(f.image, cv::imread(source.files()[k].string(), cv::IMREAD_COLOR), cv::NORM_INF), 0.0)
+        << source.files()[k];
+  }
+  EXPECT_FALSE(source.read(f));
 }
 
 }  // namespace

@@ -40,7 +40,8 @@ class ImageSequenceSource final : public FrameSource {
   const std::vector<Nanos>& times() const { return times_; }
 
  private:
-  cv::Mat decode(std::size_t i) const;
+  // The i-th image; `chroma`, when given, gets a JPEG's sampling (1×1 for other formats).
+  cv::Mat decode(std::size_t i, ChromaSampling* chroma = nullptr) const;
 
   ImageSequenceSettings settings_;
   std::vector<std::filesystem::path> files_;
