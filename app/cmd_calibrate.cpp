@@ -157,6 +157,11 @@ void register_calibrate(CLI::App& app) {
     }
     auto options = o->calib;
     options.reject_outliers = !o->no_reject;
+    // OpenCV's solve is dense, a minute or more over a hundred views: say why it waits (on
+    // stderr, as progress is: stdout may be --json).
+    if (views.corners.size() >= 50)
+      std::fprintf(stderr, "calibrate: solving from %zu views, which takes a while with this many%s\n",
+                   views.corners.size(), options.reject_outliers ? " (again for each outlier rejected)" : "");
     const auto result = calib::calibrate_robust(views, options);
     if (!o->coverage.empty()) calib::write_coverage_image(o->coverage, views, result, options);
     if (!o->preview.empty()) calib::write_undistorted_preview(o->preview, images, views, result);

@@ -67,7 +67,10 @@ int main(int argc, char** argv) {
     return 2;
   } catch (const lumar::Interrupted& e) {
     std::fprintf(stderr, "lumar: stopped: %s\n", e.what());
-    return 130;
+    // At once: a library call left running on its own thread (run_until_stopped) must
+    // not meet static destructors. Every file was closed or removed while unwinding.
+    std::fflush(nullptr);
+    std::_Exit(130);
   } catch (const lumar::RuntimeError& e) {
     std::fprintf(stderr, "lumar: failed: %s\n", e.what());
     return 1;

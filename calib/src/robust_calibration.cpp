@@ -42,13 +42,28 @@ Solve solve(const BoardViews& views, const std::vector<int>& subset, const Robus
     image_points.push_back(views.corners[i]);
     object_points.push_back(views.objects[i]);
   }
-  // With CALIB_FIX_ASPECT_RATIO OpenCV keeps the initial fx/fy ratio: start from 1.
-  cv::Mat K = cv::Mat::eye(3, 3, CV_64F), D;
-  std::vector<cv::Mat> tvecs;
-  cv::Mat std_intrinsics, std_extrinsics, per_view;
+  // OpenCV's solve is dense: a minute over 150 views, which a stop must not wait for.
+  struct Solved {
+    double rms = 0;
+    cv::Mat K, D, std_intrinsics;
+    std::vector<cv::Mat> rvecs, tvecs;
+  };
+  const Solved solved = run_until_stopped(
+      [object_points, image_points, size = views.image_size, flags = calibration_flags(o)] {
+        Solved r;
+        // With CALIB_FIX_ASPECT_RATIO OpenCV keeps the initial fx/fy ratio: start from 1.
+        r.K = cv::Mat::eye(3, 3, CV_64F);
+        cv::Mat std_extrinsics, per_view;
+        r.rms = cv::calibrateCamera(object_points, image_points, size, r.K, r.D, r.rvecs, r.tvecs, r.std_intrinsics,
+                                    std_extrinsics, per_view, flags);
+        return r;
+      },
+      "calibrate: while solving for the intrinsics");
+  const cv::Mat &K = solved.K, &D = solved.D, &std_intrinsics = solved.std_intrinsics;
+  const std::vector<cv::Mat>& tvecs = solved.tvecs;
   Solve s;
-  s.rms = cv::calibrateCamera(object_points, image_points, views.image_size, K, D, s.rvecs, tvecs, std_intrinsics,
-                              std_extrinsics, per_view, calibration_flags(o));
+  s.rms = solved.rms;
+  s.rvecs = solved.rvecs;
   CameraIntrinsics& c = s.intrinsics;
   c.width = views.image_size.width;
   c.height = views.image_size.height;
