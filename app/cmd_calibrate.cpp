@@ -138,7 +138,7 @@ void register_calibrate(CLI::App& app) {
     // after it: an OutputFile checks its path when it is made (and writes nothing).
     for (const std::string& out : {o->out, o->coverage, o->preview})
       if (!out.empty()) OutputFile{out};
-    catch_stop_signals();  // Ctrl-C stops between images and solves; nothing is written
+    catch_stop_signals();  // Ctrl-C stops between images or within a solve; nothing is written
     const std::vector<calib::NamedImage> images =
         o->source.empty() ? calib::load_board_images(inputs) : frames_from_source(*o);
     // Both boards give views for the same robust solve; the report names inner corners.
