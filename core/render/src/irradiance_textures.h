@@ -8,7 +8,8 @@
 
 namespace lumar::gl {
 
-// GLSL appended to the shaded-object fragment shader: defines
+// GLSL inserted after the shaded-object fragment shader's #version line (with_glsl_library):
+// defines sh9_irradiance and
 // vec3 volume_irradiance(vec3 p, vec3 n, vec3 n_lights, float rest_scale, float lights_scale). Texture units 8..15.
 extern const char* const kIrradianceVolumeGlsl;
 

@@ -515,7 +515,7 @@ Renderer::Renderer(const CameraIntrinsics& camera) : impl_(std::make_unique<Impl
                                 with_glsl_library(kBackgroundFragment, kCameraResponseGlsl).c_str());
   r.depth_only = create_program("proxy depth", kMeshVertex, kDepthOnlyFragment);
   r.shaded_object = create_program("shaded object", kMeshVertex,
-                                   (std::string(kShadedObjectFragment) + kIrradianceVolumeGlsl).c_str());
+                                   with_glsl_library(kShadedObjectFragment, kIrradianceVolumeGlsl).c_str());
   r.world_position = create_program("world position", kMeshVertex, kWorldPositionFragment);
   r.room_radiance = create_program("room radiance", kMeshVertex, kRoomRadianceFragment);
   r.encode =

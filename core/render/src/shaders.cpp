@@ -108,8 +108,6 @@ uniform vec3 sh[9];  // L00, L1-1, L10, L11, L2-2, L2-1, L20, L21, L22 (world fr
 uniform bool use_volume;  // irradiance volume (gl/irradiance_textures.cpp) instead of sh
 uniform bool use_self_occlusion;
 uniform bool use_vertex_irradiance;  // `lit` already holds the volume's light and the self-occlusion
-vec3 volume_irradiance(vec3 p, vec3 n, vec3 n_lights, float rest_scale, float lights_scale);
-vec3 sh9_irradiance(vec3 L0, vec3 L1, vec3 L2, vec3 L3, vec3 L4, vec3 L5, vec3 L6, vec3 L7, vec3 L8, vec3 n);
 out vec4 color;
 
 vec3 sh_irradiance(vec3 n) { return sh9_irradiance(sh[0], sh[1], sh[2], sh[3], sh[4], sh[5], sh[6], sh[7], sh[8], n); }

@@ -13,7 +13,7 @@ extern const char* const kCameraResponseGlsl;  // decoded(code): the response's 
 // Fragment stages.
 extern const char* const kBackgroundFragment;     // undistorted video, decoded to linear (+ kCameraResponseGlsl)
 extern const char* const kDepthOnlyFragment;      // proxy room as occluder
-extern const char* const kShadedObjectFragment;   // albedo * E(n) / pi * exposure, E from SH9 or the irradiance volume
+extern const char* const kShadedObjectFragment;   // albedo * E(n) / pi * exposure, E from SH9 or the irradiance volume (+ kIrradianceVolumeGlsl)
 extern const char* const kWorldPositionFragment;  // (x, y, z, 1)
 extern const char* const kRoomRadianceFragment;   // environment map projected from its capture point
 extern const char* const kEncodeFragment;         // linear -> sRGB, rows flipped for read-back; the camera's noise (+ kCameraResponseGlsl)
