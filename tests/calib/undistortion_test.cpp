@@ -1,5 +1,6 @@
-// Undistortion maps against the forward lens model and cv::undistortPoints, and
-// distort_image against the forward model, with the real webcam calibration.
+// Undistortion maps against the forward lens model and cv::undistortPoints, distort_image
+// against the forward model, with the real webcam calibration, and the undistortion in
+// linear light against remapping the light itself.
 #include "lumar/calib/undistortion.h"
 
 #include <gtest/gtest.h>
@@ -7,7 +8,9 @@
 #include <cmath>
 #include <cstdio>
 #include <opencv2/calib3d.hpp>
+#include <opencv2/imgproc.hpp>
 
+#include "lumar/base/color.h"
 #include "lumar/base/error.h"
 #include "lumar/calib/camera_file.h"
 #include "test_paths.h"
@@ -181,9 +184,96 @@ TEST(Undistortion, DistortThenUndistortRoundTrip) {
   EXPECT_LE(cv::norm(channels[0], distorted8, cv::NORM_INF), 0.0);
 }
 
+// A response unlike sRGB's: code / 255 to the power 2.2, a different gain per channel.
+CameraResponse gamma_response() {
+  CameraResponse r;
+  for (int k = 0; k < 3; ++k)
+    for (int v = 0; v < 256; ++v)
+      r.exposure[std::size_t(k)][std::size_t(v)] = (1.0f + 0.5f * float(k)) * std::pow(float(v) / 255.0f, 2.2f);
+  return r;
+}
+
+// Maps that read every pixel (dx, dy) away from its own place.
+UndistortionMaps shifted_maps(const CameraIntrinsics& camera, float dx, float dy) {
+  UndistortionMaps maps;
+  maps.map_x.create(camera.height, camera.width, CV_32FC1);
+  maps.map_y.create(camera.height, camera.width, CV_32FC1);
+  for (int r = 0; r < camera.height; ++r)
+    for (int c = 0; c < camera.width; ++c)
+      maps.map_x.at<float>(r, c) = float(c) + dx, maps.map_y.at<float>(r, c) = float(r) + dy;
+  return maps;
+}
+
+TEST(Undistortion, InLinearLightMixesLightNotCodes) {
+  // Alternate black and white columns, read half a pixel to the right: each output pixel
+  // is half of each, which in light is half of white (code 188 in sRGB), not code 128.
+  const CameraIntrinsics camera = webcam();
+  const UndistortionMaps shifted = shifted_maps(camera, 0.5f, 0.0f);
+  cv::Mat columns(camera.height, camera.width, CV_8UC3);
+  for (int c = 0; c < camera.width; ++c) columns.col(c).setTo(cv::Scalar::all(c % 2 ? 255 : 0));
+  const cv::Mat in_light = undistort_in_linear_light(columns, shifted, srgb_response(1.0));
+  const cv::Mat in_codes = undistort_image(columns, shifted);
+  const int half_white = int(std::lround(255.0 * linear_to_srgb(0.5f)));
+  EXPECT_EQ(half_white, 188);
+  for (int c = 10; c < 20; ++c)
+    for (int k = 0; k < 3; ++k) {
+      EXPECT_EQ(in_light.at<cv::Vec3b>(100, c)[k], half_white) << "column " << c;
+      EXPECT_NEAR(in_codes.at<cv::Vec3b>(100, c)[k], 128, 1) << "column " << c;
+    }
+}
+
+TEST(Undistortion, InLinearLightMatchesRemappingTheLight) {
+  // Against the brute force: the image's light remapped as floats, each value's nearest
+  // code checked against all 256. Through the real lens, with sRGB and another
+  // response.
+  const CameraIntrinsics camera = webcam();
+  const UndistortionMaps maps = make_undistortion_maps(camera);
+  const cv::Mat pattern8 = [&] {
+    cv::Mat grey;
+    draw_pattern(camera.without_distortion(), camera.without_distortion()).convertTo(grey, CV_8U, 255.0);
+    cv::Mat colour;
+    cv::merge(std::vector<cv::Mat>{grey, 255 - grey, grey / 2 + 60}, colour);
+    return colour;
+  }();
+  for (const CameraResponse& response : {srgb_response(1.0), gamma_response()}) {
+    const cv::Mat out = undistort_in_linear_light(pattern8, maps, response);
+    ASSERT_EQ(out.type(), CV_8UC3);
+    cv::Mat light;
+    cv::remap(linearize(pattern8, response), light, maps.map_x, maps.map_y, cv::INTER_LINEAR, cv::BORDER_CONSTANT);
+    // A code is right when no other code's light is nearer (a tie may go either way).
+    int wrong = 0;
+    for (int r = 0; r < out.rows; r += 3)
+      for (int c = 0; c < out.cols; c += 3)
+        for (int k = 0; k < 3; ++k) {
+          const float want = light.at<cv::Vec3f>(r, c)[k];
+          const float miss = std::abs(response(k, out.at<cv::Vec3b>(r, c)[k]) - want);
+          for (int v = 0; v < 256; ++v)
+            if (std::abs(response(k, v) - want) < miss) {
+              ++wrong;
+              break;
+            }
+        }
+    EXPECT_EQ(wrong, 0);
+  }
+}
+
+TEST(Undistortion, ResamplingVarianceIsTheBilinearMixes) {
+  // f(1 - f) per axis: none on pixel centres, 1/4 halfway between, about 1/6 (uniform f's
+  // mean) through the real lens, whose offsets cover every fraction.
+  const CameraIntrinsics camera = webcam();
+  EXPECT_EQ(resampling_variance(shifted_maps(camera, 0.0f, 0.0f)), 0.0);
+  EXPECT_NEAR(resampling_variance(shifted_maps(camera, 0.5f, 0.0f)), 0.125, 1e-9) << "halfway in x only: (1/4 + 0) / 2";
+  EXPECT_NEAR(resampling_variance(shifted_maps(camera, 0.5f, 0.5f)), 0.25, 1e-9);
+  const double lens = resampling_variance(make_undistortion_maps(camera));
+  std::printf("the webcam's undistortion: resampling variance %.4f px^2 per axis\n", lens);
+  EXPECT_NEAR(lens, 1.0 / 6.0, 0.01);
+}
+
 TEST(Undistortion, WrongImageSizeIsAnInputError) {
   const UndistortionMaps maps = make_undistortion_maps(webcam());
   EXPECT_THROW(undistort_image(cv::Mat(240, 320, CV_8UC3, cv::Scalar::all(0)), maps), InputError);
+  EXPECT_THROW(undistort_in_linear_light(cv::Mat(240, 320, CV_8UC3, cv::Scalar::all(0)), maps, srgb_response(1.0)),
+               InputError);
   CameraIntrinsics broken = webcam();
   broken.fx = 0;
   EXPECT_THROW(make_undistortion_maps(broken), InputError);

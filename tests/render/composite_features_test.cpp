@@ -2,8 +2,8 @@
 // an analytic expectation and switched off: the sensor's noise statistics, the coverage
 // that antialiasing gives a disc's outline, the Gaussian profile of a blurred edge, and the
 // self-occlusion's open share and bent normal, and the exact lights the object blocks
-// itself, against the CPU's IrradianceVolume::evaluate; the motion blur against the
-// frames drawn one instant at a time.
+// itself, the undistortion's resampling after the clipping, against the CPU's IrradianceVolume::evaluate; the motion
+// blur against the frames drawn one instant at a time.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -142,6 +142,39 @@ TEST(CompositeFeatures, BlurGivesAnEdgeTheCamerasGaussianProfile) {
   EXPECT_NEAR(sharp.at<cv::Vec3f>(60, 80)[1], 0.5f, 0.005f);
 }
 
+TEST(CompositeFeatures, TheUndistortionsResamplingFollowsTheClipping) {
+  // An object four times brighter than white whose left edge is the boundary between
+  // columns 79 and 80, and a map that reads the video half a pixel off both ways: the
+  // undistortion mixed the video's pixels by (1/2, 1/2), a variance of 1/4 per axis, so
+  // rendered pixels get the 3-tap (1/8, 3/4, 1/8) of that variance, of their clipped light.
+  headless_context();
+  FlatObject flat(4.0f, 1.0f, {1.0f, 0.0f, -2.0f});
+  cv::Mat map_x(120, 160, CV_32FC1), map_y(120, 160, CV_32FC1);
+  for (int r = 0; r < 120; ++r)
+    for (int c = 0; c < 160; ++c) map_x.at<float>(r, c) = float(c) + 0.5f, map_y.at<float>(r, c) = float(r) + 0.5f;
+  flat.renderer->set_undistortion_map(map_x, map_y);
+  flat.renderer->set_features({.antialiasing = false, .self_occlusion = false, .noise = false, .blur = true});
+  const cv::Mat black(120, 160, CV_8UC3, cv::Scalar::all(0));
+  const cv::Mat out = linear_of(flat.renderer->render_overlay(black, flat.pose, 1.0));
+  const auto at = [&](const cv::Mat& image, int c) { return image.at<cv::Vec3f>(60, c)[1]; };
+  std::printf("resampled after clipping: columns 78-81 %.4f %.4f %.4f %.4f\n", at(out, 78), at(out, 79), at(out, 80),
+              at(out, 81));
+  EXPECT_EQ(at(out, 78), 0.0f);
+  // An eighth of white, not of the unclipped 4 (which would be white itself).
+  EXPECT_NEAR(at(out, 79), 0.125f, 0.004f);
+  EXPECT_NEAR(at(out, 80), 0.875f, 0.01f);
+  EXPECT_NEAR(at(out, 81), 1.0f, 1e-6f);
+
+  // Switched off with the blur, and nothing to do without an undistortion map.
+  flat.renderer->set_features(kNone);
+  const cv::Mat off = linear_of(flat.renderer->render_overlay(black, flat.pose, 1.0));
+  EXPECT_EQ(at(off, 79), 0.0f);
+  EXPECT_NEAR(at(off, 80), 1.0f, 1e-6f);
+  FlatObject unmapped(4.0f, 1.0f, {1.0f, 0.0f, -2.0f});
+  unmapped.renderer->set_features({.antialiasing = false, .self_occlusion = false, .noise = false, .blur = true});
+  EXPECT_EQ(at(linear_of(unmapped.renderer->render_overlay(black, unmapped.pose, 1.0)), 79), 0.0f);
+}
+
 TEST(CompositeFeatures, SelfOcclusionLightsTheOpenShareFromTheBentNormal) {
   headless_context();
   FlatObject flat(0.0f);
@@ -226,7 +259,8 @@ TEST(CompositeFeatures, MotionBlurIsTheMeanOfTheShuttersInstants) {
   const auto row = [](const cv::Mat& bgr8) { return linear_of(bgr8).row(60).clone(); };
   const auto partly_covered = [](const cv::Mat& linear_row) {
     int n = 0;
-    for (int c = 0; c < linear_row.cols; ++c) n += linear_row.at<cv::Vec3f>(0, c)[1] > 0.02f && linear_row.at<cv::Vec3f>(0, c)[1] < 0.48f;
+    for (int c = 0; c < linear_row.cols; ++c)
+      n += linear_row.at<cv::Vec3f>(0, c)[1] > 0.02f && linear_row.at<cv::Vec3f>(0, c)[1] < 0.48f;
     return n;
   };
 
@@ -242,8 +276,9 @@ TEST(CompositeFeatures, MotionBlurIsTheMeanOfTheShuttersInstants) {
   }
   flat.renderer->set_object_pose(flat.id, glm::dmat4(1.0));
   const double worst = cv::norm(blurred, reference, cv::NORM_INF);
-  std::printf("motion blur over 8 px: %d partly covered pixels (12 expected), worst |blurred - mean of instants| %.4f\n",
-              partly_covered(blurred), worst);
+  std::printf(
+      "motion blur over 8 px: %d partly covered pixels (12 expected), worst |blurred - mean of instants| %.4f\n",
+      partly_covered(blurred), worst);
   EXPECT_LT(worst, 0.004) << "the mean of the frames drawn at each instant";
   EXPECT_EQ(partly_covered(blurred), 12);
   EXPECT_EQ(partly_covered(row(sharp)), 0);
@@ -261,12 +296,10 @@ TEST(CompositeFeatures, MotionBlurIsTheMeanOfTheShuttersInstants) {
 
   // Switched off, or one instant: drawn once.
   flat.renderer->set_features(kNone);
-  EXPECT_EQ(cv::norm(flat.renderer->render_overlay(black, flat.pose, 1.0, nullptr, moving_object), sharp,
-                     cv::NORM_INF),
+  EXPECT_EQ(cv::norm(flat.renderer->render_overlay(black, flat.pose, 1.0, nullptr, moving_object), sharp, cv::NORM_INF),
             0.0);
   flat.renderer->set_features({.antialiasing = false, .self_occlusion = false, .noise = false, .blur = false});
-  EXPECT_EQ(cv::norm(flat.renderer->render_overlay(black, flat.pose, 1.0, nullptr,
-                                                   std::span(moving_object).first(1)),
+  EXPECT_EQ(cv::norm(flat.renderer->render_overlay(black, flat.pose, 1.0, nullptr, std::span(moving_object).first(1)),
                      flat.renderer->render_overlay(black, flat.pose, 1.0), cv::NORM_INF),
             0.0);
   std::vector<gl::ShutterInstant> wrong = moving_object;

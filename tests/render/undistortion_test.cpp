@@ -1,11 +1,13 @@
 // The background pass: video drawn through the undistortion map must match
-// cv::remap, and the decode-to-linear / encode-to-sRGB round trip must be lossless.
+// calib::undistort_in_linear_light (cv::remap of the light), and the decode-to-linear /
+// encode-to-sRGB round trip must be lossless.
 #include <gtest/gtest.h>
 
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "lumar/base/error.h"
+#include "lumar/calib/undistortion.h"
 #include "lumar/render/renderer.h"
 #include "render_test_util.h"
 
@@ -28,7 +30,7 @@ cv::Mat textured_frame(cv::Size size) {
   return frame;
 }
 
-TEST(RenderUndistortion, MatchesCvRemap) {
+TEST(RenderUndistortion, MatchesRemappingTheLight) {
   headless_context();
   CameraIntrinsics camera = make_camera(640, 480, 536.1, 536.0, 342.4, 235.5);
   camera.distortion = {-0.28, 0.09, 0.001, -0.0005, 0.0};
@@ -38,8 +40,8 @@ TEST(RenderUndistortion, MatchesCvRemap) {
   cv::initUndistortRectifyMap(K, camera.distortion_coefficients(), cv::Mat(), K, size, CV_32FC1, map_x, map_y);
 
   const cv::Mat frame = textured_frame(size);
-  cv::Mat expected;
-  cv::remap(frame, expected, map_x, map_y, cv::INTER_LINEAR, cv::BORDER_CONSTANT);
+  // The renderer's default response is sRGB's.
+  const cv::Mat expected = calib::undistort_in_linear_light(frame, {map_x, map_y, camera}, calib::srgb_response(1.0));
 
   gl::Renderer renderer(camera);
   renderer.set_undistortion_map(map_x, map_y);
@@ -63,14 +65,33 @@ TEST(RenderUndistortion, MatchesCvRemap) {
       ++count;
     }
   const double mean = sum / (3.0 * count);
-  std::printf("undistortion vs cv::remap: %d interior pixels, mean |diff| %.4f levels, max %d levels\n", count, mean,
-              worst);
+  std::printf("undistortion vs the light remapped: %d interior pixels, mean |diff| %.4f levels, max %d levels\n", count,
+              mean, worst);
   EXPECT_GT(count, size.area() / 2);
   EXPECT_LE(mean, 1.0);
   // The distortion is strong at the corners: the warp must really be applied.
   cv::Mat unwarped_diff;
   cv::absdiff(out, frame, unwarped_diff);
   EXPECT_GT(cv::mean(unwarped_diff)[0], 5.0);
+}
+
+TEST(RenderUndistortion, MixesLightNotCodes) {
+  // Black and white columns read half a pixel to the right: every pixel is half of each,
+  // which in light is sRGB code 188. Mixing the codes, as cv::remap of the frame does,
+  // would give 128 and darken every edge between bright and dark.
+  headless_context();
+  const CameraIntrinsics camera = make_camera(64, 48, 60, 60, 32, 24);
+  cv::Mat map_x(camera.height, camera.width, CV_32FC1), map_y(camera.height, camera.width, CV_32FC1);
+  for (int r = 0; r < camera.height; ++r)
+    for (int c = 0; c < camera.width; ++c) map_x.at<float>(r, c) = float(c) + 0.5f, map_y.at<float>(r, c) = float(r);
+  cv::Mat columns(camera.height, camera.width, CV_8UC3);
+  for (int c = 0; c < camera.width; ++c) columns.col(c).setTo(cv::Scalar::all(c % 2 ? 255 : 0));
+  gl::Renderer renderer(camera);
+  renderer.set_undistortion_map(map_x, map_y);
+  const cv::Mat out = renderer.render_overlay(columns, Pose{}, 1.0);
+  for (int r = 1; r < camera.height - 1; r += 7)
+    for (int c = 1; c < camera.width - 2; ++c)
+      for (int k = 0; k < 3; ++k) ASSERT_NEAR(out.at<cv::Vec3b>(r, c)[k], 188, 1) << "pixel " << c << ", " << r;
 }
 
 TEST(RenderUndistortion, WithoutMapTheVideoRoundTripsExactly) {

@@ -86,7 +86,8 @@ Overlay::Overlay(std::shared_ptr<const LoadedScene> scene, const CameraIntrinsic
   if (!(shutter_s_ >= 0.0 && shutter_s_ <= 1.0))
     throw InputError(fmt::format("overlay: a shutter time of {} s; use 0 (no motion blur) to 1 s", shutter_s_));
   shutter_instants_ = settings.shutter_instants;
-  if (shutter_instants_ < OverlaySettings::kMinShutterInstants || shutter_instants_ > OverlaySettings::kMaxShutterInstants)
+  if (shutter_instants_ < OverlaySettings::kMinShutterInstants ||
+      shutter_instants_ > OverlaySettings::kMaxShutterInstants)
     throw InputError(fmt::format("overlay: {} shutter instants; use {} to {}", shutter_instants_,
                                  OverlaySettings::kMinShutterInstants, OverlaySettings::kMaxShutterInstants));
   if (settings.window) {
@@ -104,10 +105,11 @@ Overlay::Overlay(std::shared_ptr<const LoadedScene> scene, const CameraIntrinsic
     context_ = gl::create_headless_context();
   }
   maps_ = calib::make_undistortion_maps(camera, settings.undistortion);
+  resampling_variance_ = calib::resampling_variance(maps_);
   const calib::UndistortionMaps& maps = maps_;
-  compositor_ = std::make_unique<Compositor>(with_volume_knobs(std::move(scene), quality_), maps.output, maps.map_x,
-                                             maps.map_y,
-                                             CompositorSettings{settings.volume_cache, settings.features, quality_.shadows});
+  compositor_ =
+      std::make_unique<Compositor>(with_volume_knobs(std::move(scene), quality_), maps.output, maps.map_x, maps.map_y,
+                                   CompositorSettings{settings.volume_cache, settings.features, quality_.shadows});
   // The renderer's linear unit is the response's (sRGB with gain 1 without one).
   response_ = response.value_or(calib::srgb_response(1.0));
   radiometry_ = renderer_radiometry(radiometry, camera, response);
@@ -141,10 +143,14 @@ void Overlay::measure_camera(const cv::Mat& video) {
       failed += std::string(e.what()) + "; ";
     }
   if (!blur_known_) try {
-      const calib::CameraBlur blur = calib::estimate_camera_blur(calib::undistort_image(video, maps_));
-      // Antialiasing already averages each pixel's area, a box of variance 1/12 px².
+      const calib::CameraBlur blur =
+          calib::estimate_camera_blur(calib::undistort_in_linear_light(video, maps_, response_));
+      // Antialiasing already averages each pixel's area, a box of variance 1/12 px², and
+      // the renderer resamples what it rendered as the undistortion did the video, after
+      // the clipping; the Gaussian is what is left, the blur before the clipping.
       const double box = compositor_->renderer().features().antialiasing ? 1.0 / 12.0 : 0.0;
-      radiometry_.blur_sigma_px = std::min(4.0, std::sqrt(std::max(0.0, blur.sigma_px * blur.sigma_px - box)));
+      const double before_clipping = blur.sigma_px * blur.sigma_px - box - resampling_variance_;
+      radiometry_.blur_sigma_px = std::min(4.0, std::sqrt(std::max(0.0, before_clipping)));
       blur_known_ = true;
       spdlog::debug("camera blur: sigma {:.2f} px from {} edge pixels", blur.sigma_px, blur.edges);
     } catch (const InputError& e) {
@@ -179,8 +185,9 @@ void Overlay::set_scene(std::shared_ptr<const LoadedScene> scene) {
   quality_.coverage_mesh_px = compositor_->renderer().coverage_mesh_error();
   scene_ = scene;
   compositor_.reset();  // its GL objects go first
-  compositor_ = std::make_unique<Compositor>(with_volume_knobs(std::move(scene), quality_), maps_.output, maps_.map_x,
-                                             maps_.map_y, CompositorSettings{volume_cache_, features, quality_.shadows});
+  compositor_ =
+      std::make_unique<Compositor>(with_volume_knobs(std::move(scene), quality_), maps_.output, maps_.map_x,
+                                   maps_.map_y, CompositorSettings{volume_cache_, features, quality_.shadows});
   compositor_->set_object_shading(quality_.shading);
   compositor_->renderer().set_coverage_mesh_error(quality_.coverage_mesh_px);
   compositor_->renderer().set_video_radiometry(radiometry_);
@@ -335,8 +342,7 @@ void Overlay::draw(OverlayFrame& out, const capture::Frame& frame, const FrameLi
     }
   }
   gl::OverlayTimings gt;
-  out.composite =
-      compositor_->render(light, frame.image, T_world_camera, exposure_ * exposure_scale_, &gt, shutter);
+  out.composite = compositor_->render(light, frame.image, T_world_camera, exposure_ * exposure_scale_, &gt, shutter);
   times_.shadows += gt.shadows_ms;
   times_.vertex_light += gt.vertex_light_ms;
   times_.upload += gt.upload_ms;

@@ -32,7 +32,8 @@ QualityTrial run_trial(Overlay& overlay, const std::vector<ProbeFrame>& frames, 
     if (i > 0) ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
     if (is_reference) {
       reference.composite.push_back(out.composite);
-      reference.empty.push_back(calib::undistort_image(frames[i].frame.image, overlay.undistortion()));
+      reference.empty.push_back(
+          calib::undistort_in_linear_light(frames[i].frame.image, overlay.undistortion(), overlay.response()));
       reference.mask.push_back(overlay.compositor().renderer().render_object_mask(frames[i].T_world_camera));
     }
     meter.add(out.composite, reference.composite[i], reference.composite[i], reference.empty[i], reference.mask[i]);

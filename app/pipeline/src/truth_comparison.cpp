@@ -17,7 +17,9 @@ std::optional<TruthComparison> compare_with_truth(const std::filesystem::path& d
   ReplayOverlay overlay(dir, settings);
   const capture::Session& session = overlay.replay().session();
   const calib::UndistortionMaps maps = calib::make_undistortion_maps(session.camera, settings.overlay.undistortion);
-  CompositeErrorMeter meter(calib::calibrated_response(session.radiometry, dir).value_or(calib::srgb_response(1.0)));
+  const calib::CameraResponse response =
+      calib::calibrated_response(session.radiometry, dir).value_or(calib::srgb_response(1.0));
+  CompositeErrorMeter meter(response);
   const auto file = [&](const char* kind, std::int64_t index) {
     return truth / fmt::format("{}-{:05d}.png", kind, index);
   };
@@ -29,7 +31,9 @@ std::optional<TruthComparison> compare_with_truth(const std::filesystem::path& d
     if (image.size() != maps.map_x.size())
       throw InputError(path.string() + ": truth frame is " + std::to_string(image.cols) + "x" +
                        std::to_string(image.rows) + ", not the video's size");
-    return calib::undistort_image(image, maps);
+    // Resampled in linear light, as the composite's background is (the mask by value).
+    return image.channels() == 3 ? calib::undistort_in_linear_light(image, maps, response)
+                                 : calib::undistort_image(image, maps);
   };
   const auto total_ms = [&] { return overlay.overlay().times().total(); };
   // The first frame pays for the shaders' compilation: timed from the second on.

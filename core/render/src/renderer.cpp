@@ -174,8 +174,8 @@ struct Renderer::Impl {
 
   CameraIntrinsics camera;
   GlName empty_vertex_array;  // core profile needs one bound even for attribute-less draws
-  GlName background, depth_only, shaded_object, world_position, room_radiance, encode, blur, covered, antialias_resolve,
-      weighted_copy;
+  GlName background, depth_only, shaded_object, world_position, room_radiance, encode, blur, resample, covered,
+      antialias_resolve, weighted_copy;
   GpuMesh room;
   std::unique_ptr<ShadowPass> receivers;  // shadow receivers, drawn over the video
   std::unique_ptr<ShadowPass> contact;    // dense receivers where objects touch them, drawn after
@@ -207,6 +207,7 @@ struct Renderer::Impl {
   RenderTarget scratch, scratch_rows;  // a copy of part of `scene`, the blur's rows (RGBA32F)
   RenderTarget still, accumulated;     // motion blur: the background kept, the instants' sum (RGBA32F)
   RenderTarget encoded;                // sRGB 8-bit, output size, rows flipped for read-back
+  RenderTarget encoded_copy;           // part of `encoded`, for the resample pass to read
   RenderTarget room_target;            // for render_room_radiance, resized on demand
 
   Object& object(int id, const char* where) {
@@ -263,15 +264,11 @@ struct Renderer::Impl {
 
   void upload_video(const cv::Mat& frame) {
     if (frame.cols != video_width || frame.rows != video_height) {
-      video = create_texture_2d(GL_RGB8, frame.cols, frame.rows, GL_LINEAR, GL_CLAMP_TO_EDGE, GL_CLAMP_TO_EDGE);
+      // Read by texel (the background pass filters in linear light), never filtered as codes.
+      video = create_texture_2d(GL_RGB8, frame.cols, frame.rows, GL_NEAREST, GL_CLAMP_TO_EDGE, GL_CLAMP_TO_EDGE);
       video_width = frame.cols;
       video_height = frame.rows;
     }
-    // Undistorted: black outside the frame, as cv::remap's default constant border.
-    // Merely scaled: the edge texels extend, so the image border is not darkened.
-    const GLint wrap = undistortion_map ? GL_CLAMP_TO_BORDER : GL_CLAMP_TO_EDGE;
-    glTextureParameteri(video.get(), GL_TEXTURE_WRAP_S, wrap);
-    glTextureParameteri(video.get(), GL_TEXTURE_WRAP_T, wrap);
     upload_bgr8(video.get(), frame);
   }
 
@@ -338,6 +335,8 @@ struct Renderer::Impl {
            cv::Rect(0, 0, camera.width, camera.height);
   }
 
+  int blur_radius() const { return std::min(int(std::ceil(3.0f * blur_sigma)), kMaxBlurRadius); }
+
   // The camera's blur on what was rendered, in `scene` in place: a separable Gaussian
   // (rows, then columns), kept only where it reaches a rendered pixel (alpha > 0); the
   // video elsewhere has the camera's blur already. Rendered pixels lie within the objects'
@@ -345,7 +344,7 @@ struct Renderer::Impl {
   void blur_rendered(const cv::Rect& box) {
     if (box.empty()) return;
     make_scratch();
-    const int radius = std::min(int(std::ceil(3.0f * blur_sigma)), kMaxBlurRadius);
+    const int radius = blur_radius();
     const cv::Rect changed = grown(box, radius), read = grown(box, 2 * radius);
     copy_within(scene.framebuffer.get(), scratch, read);
     const GLuint p = blur.get();
@@ -361,6 +360,29 @@ struct Renderer::Impl {
     begin_within(scene, changed);
     glBindTextureUnit(shaders::kBlurSourceUnit, scratch_rows.color.get());
     glProgramUniform2i(p, uniform(p, "step"), 0, 1);
+    draw_fullscreen();
+    glDisable(GL_SCISSOR_TEST);
+  }
+
+  // Rendered pixels (scene alpha > 0) within `box` (GL rows of `scene`), in `encoded`:
+  // resampled as the undistortion resampled the video, after the encode pass's clipping,
+  // and their light spread into the video pixels beside them.
+  void resample_rendered(const cv::Rect& box) {
+    if (box.empty() || !undistortion_map) return;
+    if (encoded_copy.width != camera.width || encoded_copy.height != camera.height)
+      encoded_copy = RenderTarget(camera.width, camera.height, GL_RGBA8, false, "the encoded output's copy");
+    const cv::Rect changed = grown(cv::Rect(box.x, camera.height - box.y - box.height, box.width, box.height), 1);
+    copy_within(encoded.framebuffer.get(), encoded_copy, grown(changed, 1));
+    begin_within(encoded, changed);
+    const GLuint p = resample.get();
+    glUseProgram(p);
+    glProgramUniform1i(p, uniform(p, "use_response_lut"), response_encode ? 1 : 0);
+    glProgramUniform3fv(p, uniform(p, "lut_max"), 1, glm::value_ptr(response_max));
+    glBindTextureUnit(shaders::kLinearImageUnit, scene.color.get());
+    glBindTextureUnit(shaders::kEncodedUnit, encoded_copy.color.get());
+    glBindTextureUnit(shaders::kUndistortionMapUnit, undistortion_map.get());
+    glBindTextureUnit(shaders::kResponseDecodeUnit, response_decode.get());
+    glBindTextureUnit(shaders::kResponseEncodeUnit, response_encode.get());
     draw_fullscreen();
     glDisable(GL_SCISSOR_TEST);
   }
@@ -521,6 +543,8 @@ Renderer::Renderer(const CameraIntrinsics& camera) : impl_(std::make_unique<Impl
   r.encode =
       create_program("sRGB encode", kFullscreenVertex, with_glsl_library(kEncodeFragment, kCameraResponseGlsl).c_str());
   r.blur = create_program("camera blur", kFullscreenVertex, kBlurFragment);
+  r.resample =
+      create_program("resample", kFullscreenVertex, with_glsl_library(kResampleFragment, kCameraResponseGlsl).c_str());
   r.covered = create_program("object coverage", kMeshVertex, kCoveredFragment);
   r.antialias_resolve = create_program("antialiasing", kFullscreenVertex, kAntialiasFragment);
   r.weighted_copy = create_program("motion blur sum", kFullscreenVertex, kWeightedCopyFragment);
@@ -750,8 +774,9 @@ cv::Mat Renderer::render_overlay(const cv::Mat& video_bgr8, const std::optional<
   Impl& r = *impl_;
   for (const ShutterInstant& instant : shutter)
     if (instant.T_world_model.size() != r.objects.size())
-      throw InputError("Renderer::render_overlay: a shutter instant has " + std::to_string(instant.T_world_model.size()) +
-                       " object poses for " + std::to_string(r.objects.size()) + " objects");
+      throw InputError("Renderer::render_overlay: a shutter instant has " +
+                       std::to_string(instant.T_world_model.size()) + " object poses for " +
+                       std::to_string(r.objects.size()) + " objects");
   OverlayTimings t;
   if (timings) {  // the compositor's, before this call
     t.shadows_ms = timings->shadows_ms;
@@ -797,8 +822,11 @@ cv::Mat Renderer::render_overlay(const cv::Mat& video_bgr8, const std::optional<
   const bool antialiasing = r.features.antialiasing && r.multisampled.samples > 1;
   const bool blur = r.features.blur && r.blur_sigma > 0.0f;
   const bool chroma = r.features.chroma && r.chroma_block != glm::ivec2(1);
+  // The blur's part that follows the clipping: the undistortion's resampling (resample_rendered).
+  const bool resample = T_world_camera && r.features.blur && r.undistortion_map;
   const glm::mat4 vp = T_world_camera ? Impl::view_projection(r.camera, *T_world_camera) : glm::mat4(1.0f);
-  const cv::Rect footprint = T_world_camera && (antialiasing || blur || chroma) ? r.objects_footprint(vp) : cv::Rect();
+  const cv::Rect footprint =
+      T_world_camera && (antialiasing || blur || chroma || resample) ? r.objects_footprint(vp) : cv::Rect();
   if (T_world_camera && antialiasing) {
     r.antialias(vp, footprint, *T_world_camera);
     clock.mark(&t.antialiasing_ms);
@@ -842,11 +870,21 @@ cv::Mat Renderer::render_overlay(const cv::Mat& video_bgr8, const std::optional<
                      mixed.empty() ? 1 : r.chroma_block.y);
   glProgramUniform4i(enc, uniform(enc, "chroma_region"), mixed.x, mixed.y, mixed.br().x, mixed.br().y);
   r.draw_fullscreen();
+  double encode_ms = 0;
+  if (resample) {
+    clock.mark(&encode_ms);
+    // Rendered pixels reach as far as the blur spread them.
+    r.resample_rendered(r.grown(Impl::bounding(footprint, moving), blur ? r.blur_radius() : 0));
+    double resample_ms = 0;
+    clock.mark(&resample_ms);
+    t.blur_ms += resample_ms;
+  }
   cv::Mat out(r.camera.height, r.camera.width, CV_8UC3);
   glPixelStorei(GL_PACK_ALIGNMENT, 1);
   glPixelStorei(GL_PACK_ROW_LENGTH, 0);
   glReadPixels(0, 0, out.cols, out.rows, GL_BGR, GL_UNSIGNED_BYTE, out.data);
   clock.mark(&t.readback_ms);
+  t.readback_ms += encode_ms;
   check_gl_errors("Renderer::render_overlay");
   if (timings) *timings = t;
   return out;

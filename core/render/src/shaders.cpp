@@ -12,8 +12,8 @@ void main() {
 )glsl";
 
 const char* const kCameraResponseGlsl = R"glsl(
-// The camera's response, from its code to linear light: one table for every pass that
-// decodes codes (the video, and the encode pass's chroma).
+// The camera's response, from its code to linear light and back: one pair of tables for
+// every pass that decodes or encodes codes (the video, the encode and resample passes).
 layout(binding = 4) uniform sampler2D response_decode;  // 256 x 1 RGB: linear value of each code
 uniform bool use_response_lut;  // false: the default sRGB response
 
@@ -27,6 +27,24 @@ vec3 decoded(vec3 code) {
   vec3 x = (clamp(code, 0.0, 1.0) * 255.0 + 0.5) / 256.0;
   return vec3(texture(response_decode, vec2(x.r, 0.5)).r, texture(response_decode, vec2(x.g, 0.5)).g,
               texture(response_decode, vec2(x.b, 0.5)).b);
+}
+
+layout(binding = 5) uniform sampler2D response_encode;  // N x 1 RGB: code / 255 at linear = s^2 * lut_max
+uniform vec3 lut_max;  // linear value of code 255, per channel
+
+vec3 linear_to_srgb(vec3 v) {
+  v = clamp(v, 0.0, 1.0);
+  return mix(v * 12.92, 1.055 * pow(v, vec3(1.0 / 2.4)) - 0.055, greaterThan(v, vec3(0.0031308)));
+}
+
+// Linear light to the camera's code over 255, through its response (back: decoded()).
+vec3 encoded(vec3 linear) {
+  if (!use_response_lut) return linear_to_srgb(linear);
+  vec3 s = sqrt(clamp(linear / lut_max, 0.0, 1.0));
+  float n = float(textureSize(response_encode, 0).x);
+  vec3 x = (s * (n - 1.0) + 0.5) / n;
+  return vec3(texture(response_encode, vec2(x.r, 0.5)).r, texture(response_encode, vec2(x.g, 0.5)).g,
+              texture(response_encode, vec2(x.b, 0.5)).b);
 }
 )glsl";
 
@@ -66,25 +84,37 @@ void main() {
 
 const char* const kBackgroundFragment = R"glsl(
 #version 450 core
-layout(binding = 0) uniform sampler2D video;           // texel row 0 = top row of the frame
+layout(binding = 0) uniform sampler2D video;           // codes; texel row 0 = top row of the frame
 layout(binding = 1) uniform sampler2D undistortion_map; // RG32F, output size, row 0 = top
 uniform bool use_undistortion_map;
 uniform vec2 output_size;
 out vec4 color;
 
-void main() {
-  vec2 uv;
-  if (use_undistortion_map) {
-    // OpenCV pixel of this fragment (the framebuffer's row 0 is the bottom).
-    ivec2 pixel = ivec2(gl_FragCoord.x, output_size.y - gl_FragCoord.y);
-    // OpenCV puts pixel centres at integers, GL at half-integers.
-    uv = (texelFetch(undistortion_map, pixel, 0).xy + 0.5) / vec2(textureSize(video, 0));
-  } else {
-    uv = vec2(gl_FragCoord.x, output_size.y - gl_FragCoord.y) / output_size;
+// One video pixel's linear light. Outside the frame: black when undistorting (as
+// cv::remap's constant border), the nearest edge pixel when merely scaling.
+vec3 video_pixel(ivec2 t) {
+  ivec2 size = textureSize(video, 0);
+  if (any(lessThan(t, ivec2(0))) || any(greaterThanEqual(t, size))) {
+    if (use_undistortion_map) return decoded(vec3(0.0));
+    t = clamp(t, ivec2(0), size - 1);
   }
-  // Filter the encoded values, as cv::remap does, then decode. Alpha 0 marks video
-  // pixels: the encode pass vignettes only what was rendered.
-  color = vec4(decoded(texture(video, uv).rgb), 0.0);
+  return decoded(texelFetch(video, t, 0).rgb);
+}
+
+void main() {
+  // The OpenCV pixel of the video this fragment shows (the framebuffer's row 0 is the
+  // bottom; OpenCV puts pixel centres at integers, GL at half-integers).
+  vec2 here = vec2(gl_FragCoord.x, output_size.y - gl_FragCoord.y);
+  vec2 p = use_undistortion_map ? texelFetch(undistortion_map, ivec2(here), 0).xy
+                                : here / output_size * vec2(textureSize(video, 0)) - 0.5;
+  // Bilinear in linear light (docs/conventions.md): neighbouring pixels' light mixes, their
+  // codes do not. Mixing codes would darken every edge between a bright and a dark area.
+  ivec2 t = ivec2(floor(p));
+  vec2 w = p - floor(p);
+  vec3 top = mix(video_pixel(t), video_pixel(t + ivec2(1, 0)), w.x);
+  vec3 bottom = mix(video_pixel(t + ivec2(0, 1)), video_pixel(t + ivec2(1, 1)), w.x);
+  // Alpha 0 marks video pixels: the encode pass vignettes only what was rendered.
+  color = vec4(mix(top, bottom, w.y), 0.0);
 }
 )glsl";
 
@@ -169,9 +199,7 @@ const char* const kEncodeFragment = R"glsl(
 #version 450 core
 layout(binding = 3) uniform sampler2D linear_image;
 layout(binding = 1) uniform sampler2D undistortion_map; // RG32F, output size, row 0 = top
-layout(binding = 5) uniform sampler2D response_encode;  // N x 1 RGB: code / 255 at linear = s^2 * lut_max
 uniform bool use_undistortion_map;
-uniform vec3 lut_max;            // linear value of code 255, per channel
 uniform vec2 principal_point;    // OpenCV pixels of the video's (distorted) camera
 uniform float half_diagonal;     // of the video's image, pixels
 uniform vec2 vignetting;         // (a, b): gain 1 + a r^2 + b r^4
@@ -199,21 +227,6 @@ vec3 noise_gaussian(ivec2 pixel) {
   float r1 = sqrt(-2.0 * log(u1)), r2 = sqrt(-2.0 * log(u3));
   const float tau = 6.28318530717959;
   return vec3(r1 * cos(tau * u2), r1 * sin(tau * u2), r2 * cos(tau * u4));
-}
-
-vec3 linear_to_srgb(vec3 v) {
-  v = clamp(v, 0.0, 1.0);
-  return mix(v * 12.92, 1.055 * pow(v, vec3(1.0 / 2.4)) - 0.055, greaterThan(v, vec3(0.0031308)));
-}
-
-// Linear light to the camera's code over 255, through its response (back: decoded()).
-vec3 encoded(vec3 linear) {
-  if (!use_response_lut) return linear_to_srgb(linear);
-  vec3 s = sqrt(clamp(linear / lut_max, 0.0, 1.0));
-  float n = float(textureSize(response_encode, 0).x);
-  vec3 x = (s * (n - 1.0) + 0.5) / n;
-  return vec3(texture(response_encode, vec2(x.r, 0.5)).r, texture(response_encode, vec2(x.g, 0.5)).g,
-              texture(response_encode, vec2(x.b, 0.5)).b);
 }
 
 // The linear light at OpenCV pixel q (clamped to the image), in alpha its rendered share.
@@ -310,6 +323,44 @@ void main() {
   // After the columns: the blur where it reaches a rendered pixel, the video as it was
   // elsewhere (the camera blurred it already).
   color = step.y == 1 && b.a <= 0.0 ? texelFetch(linear_image, p, 0) : b;
+}
+)glsl";
+
+const char* const kResampleFragment = R"glsl(
+#version 450 core
+layout(binding = 3) uniform sampler2D linear_image;      // the scene, rows bottom up (alpha > 0: rendered)
+layout(binding = 8) uniform sampler2D encoded_image;     // the encode pass's output: codes / 255, OpenCV rows
+layout(binding = 1) uniform sampler2D undistortion_map;  // RG32F, output size, row 0 = top
+out vec4 color;
+
+// The truth's video is sampled, clipped and coded at the camera's pixels, then undistorted
+// bilinearly: at a video pixel's fractional offset f the undistortion mixes
+// (1 - f, f) of two neighbours, a blur of variance f(1 - f) after the clipping. The video
+// here had it in the background pass; rendered pixels get it now, after their clipping,
+// as a symmetric 3-tap (a, 1 - 2a, a) of the same variance, a = f(1 - f) / 2.
+void main() {
+  ivec2 p = ivec2(gl_FragCoord.xy), size = textureSize(encoded_image, 0);
+  vec4 here = texelFetch(encoded_image, p, 0);
+  vec2 f = fract(texelFetch(undistortion_map, p, 0).xy);
+  vec2 a = 0.5 * f * (1.0 - f);
+  vec3 wx = vec3(a.x, 1.0 - 2.0 * a.x, a.x), wy = vec3(a.y, 1.0 - 2.0 * a.y, a.y);
+  bool rendered_here = texelFetch(linear_image, ivec2(p.x, size.y - 1 - p.y), 0).a > 0.0;
+  // A video pixel takes only its rendered neighbours' share: its own resampling is done.
+  vec3 sum = vec3(0.0);
+  float taken = 0.0;
+  for (int j = 0; j < 3; ++j)
+    for (int i = 0; i < 3; ++i) {
+      ivec2 n = clamp(p + ivec2(i - 1, j - 1), ivec2(0), size - 1);
+      if (!rendered_here && texelFetch(linear_image, ivec2(n.x, size.y - 1 - n.y), 0).a <= 0.0) continue;
+      float w = wx[i] * wy[j];
+      sum += w * decoded(texelFetch(encoded_image, n, 0).rgb);
+      taken += w;
+    }
+  if (taken <= 0.0) {
+    color = here;
+    return;
+  }
+  color = vec4(encoded(sum + (1.0 - taken) * decoded(here.rgb)), 1.0);
 }
 )glsl";
 

@@ -4,6 +4,7 @@
 #include <opencv2/core.hpp>
 
 #include "lumar/base/camera.h"
+#include "lumar/calib/camera_response.h"
 
 namespace lumar::calib {
 
@@ -26,6 +27,17 @@ UndistortionMaps make_undistortion_maps(const CameraIntrinsics& distorted,
 // Bilinear remap; pixels that look outside the distorted image become 0. Throws
 // InputError when the image size differs from the calibration's.
 cv::Mat undistort_image(const cv::Mat& image, const UndistortionMaps& maps);
+
+// The same remap of a camera's 8-bit BGR image in linear light (docs/conventions.md):
+// each code decoded through `response`, the light interpolated, the result encoded back
+// to the nearest code. Outside the distorted image is code 0. The composite's background
+// is undistorted so; undistort_image's mixing of codes would darken every bright/dark edge.
+cv::Mat undistort_in_linear_light(const cv::Mat& image8, const UndistortionMaps& maps, const CameraResponse& response);
+
+// The blur a bilinear remap through `maps` adds, as a variance in px² per axis, averaged
+// over the output pixels that sample the image: at a source offset with fractional part f
+// it mixes (1 − f, f) of two pixels, a variance of f(1 − f); 1/6 where f is uniform.
+double resampling_variance(const UndistortionMaps& maps);
 
 // The image `distorted_camera` would see, made from a pinhole image of the same scene
 // taken from the same centre (pinhole_camera may be larger, e.g. supersampled, with

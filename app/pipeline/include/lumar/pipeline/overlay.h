@@ -207,6 +207,7 @@ class Overlay {
   // The camera's noise and blur, measured from the video until they are known.
   void measure_camera(const cv::Mat& video);
   calib::UndistortionMaps maps_;
+  double resampling_variance_ = 0;  // of the undistortion, px² per axis (calib::resampling_variance)
   calib::CameraResponse response_;
   gl::VideoRadiometry radiometry_;
   bool noise_known_ = false, blur_known_ = false, warned_ = false;

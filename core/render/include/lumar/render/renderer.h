@@ -50,7 +50,9 @@ struct VideoRadiometry {
   // The sensor's noise per channel (B, G, R) in the response's linear units: variance
   // read_variance + shot_gain * linear (calib/sensor_noise.h estimates it from video).
   std::array<float, 3> noise_read_variance{}, noise_shot_gain{};
-  // The camera's blur (lens, sensor, resampling) as a Gaussian, output pixels.
+  // The camera's blur before its clipping (lens, sensor) as a Gaussian, output pixels.
+  // The undistortion's resampling, which follows the clipping, is applied apart, where
+  // the renderer has an undistortion map (CompositeFeatures::blur).
   double blur_sigma_px = 0.0;
   // How many pixels share one chroma sample in the camera's or codec's YCbCr, along x and
   // y (1 or 2 each): 2×2 for 4:2:0 (JPEG, H.264), 2×1 for 4:2:2 (YUYV), 1×1 for none.
@@ -63,7 +65,7 @@ struct CompositeFeatures {
   bool antialiasing = true;    // the objects' coverage of outline pixels, from 4 samples (MSAA)
   bool self_occlusion = true;  // the objects' baked occlusion of themselves
   bool noise = true;           // VideoRadiometry's noise on rendered pixels
-  bool blur = true;            // VideoRadiometry's blur on rendered pixels and their edges
+  bool blur = true;            // VideoRadiometry's blur, and the undistortion's resampling, on rendered pixels
   bool chroma = true;          // VideoRadiometry's chroma subsampling on rendered pixels and their edges
   bool bounce = true;          // the objects' light reflected onto the receivers (the Compositor's)
   // The objects' shadows on the room from the radiosity lines (the Compositor's); off:
