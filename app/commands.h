@@ -23,7 +23,8 @@ void add_live_input_options(
 
 // --without and --blur-sigma: what makes rendered pixels look like the camera's
 // (gl::CompositeFeatures); --shading: the objects' light per pixel or per vertex
-// (ObjectShading); --shadow-lines: lines per receiver and emitter patch (ShadowQuality);
+// (ObjectShading); --shadow-lines: lines per receiver and emitter patch, --contact-moving:
+// the contact receivers at every pose of a moving object (ShadowQuality);
 // --exact-lights and --shadow-map: the volume's lights evaluated with shadow maps, and
 // their maps' size (pipeline::OverlayQuality); --quality auto and --quality-budget: those
 // knobs chosen on a recording's frames (pipeline/quality_choice.h).
@@ -35,6 +36,7 @@ struct CompositeOptions {
   int shutter_instants = pipeline::OverlaySettings{}.shutter_instants;
   std::string shading = "pixel";
   int shadow_lines = ShadowQuality{}.lines_per_patch;
+  bool contact_moving = ShadowQuality{}.contact_while_moving;
   int exact_lights = -1;  // -1: the manifest's
   int shadow_map = -1;    // -1: the manifest's
   double coverage_mesh_px = pipeline::OverlayQuality{}.coverage_mesh_px;

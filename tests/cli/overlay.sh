@@ -222,6 +222,23 @@ for line in open(sys.argv[1]).read().splitlines():
 PY
 }
 
+# --contact-moving: the walking figurines get their contact shadows at every frame; at
+# rest (the first frame, before they set off) the frame is the same as without it.
+case_contact_shadows_while_moving() {
+  for mode in still moving; do
+    flag=()
+    [ $mode = still ] || flag=(--contact-moving)
+    "$LUMAR" overlay --recording "$SRC/recordings/walk" --poses truth --max-frames 6 --frames-dir "$TMP/$mode" \
+      "${flag[@]}" >"$TMP/log_$mode" 2>&1 || { cat "$TMP/log_$mode"; fail "overlay ($mode) failed"; }
+  done
+  cmp -s "$TMP/still/frame-000000.png" "$TMP/moving/frame-000000.png" || fail "the frame at rest differs"
+  diff=$(python3 "$SRC/tests/cli/png_tool.py" mean-abs-diff "$TMP/still/frame-000005.png" \
+    "$TMP/moving/frame-000005.png")
+  echo "frame 5, with and without: mean difference $diff levels"
+  python3 -c "import sys; sys.exit(not float(sys.argv[1]) > 0.005)" "$diff" ||
+    fail "a walking frame got no contact shadow"
+}
+
 case_overlay_pose_sources() {
   # fused (the default), tracker and truth differ from the first frame on (the fused pose
   # starts from the frame aligned with the proxy's room); without fixes (--fix-worth 0)

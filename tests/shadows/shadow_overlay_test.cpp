@@ -246,21 +246,43 @@ TEST(ShadowOverlay, WithoutTheLinesTheFloorDarkensByThe2004Spheres) {
   EXPECT_EQ(cv::norm(compositor.composite(video, pose, exposure), lines, cv::NORM_INF), 0.0);
 }
 
+// The sample view's figurine standing on the floor, composited with only what bears on
+// its shadows (no bounce, noise or blur), over the room's video seen from there.
+struct StandingFigurine {
+  static constexpr double kExposure = 0.66;
+  SampleView view = sample_view();
+  Compositor compositor{std::make_shared<const LoadedScene>(view.scene), view.camera, cv::Mat(), cv::Mat()};
+  cv::Mat video;
+  StandingFigurine() {
+    gl::CompositeFeatures features;
+    features.bounce = features.noise = features.blur = false;
+    compositor.set_features(features);
+    video = room_video(compositor, view.camera, view.pose, kExposure);
+  }
+  cv::Mat composite() { return compositor.composite(video, view.pose, kExposure); }
+  // The mean of the contact receivers' positions (there must be some).
+  glm::dvec3 contact_centre() const {
+    glm::dvec3 c(0.0);
+    for (const glm::vec3& p : compositor.contact_shadows()->lines().origins) c += glm::dvec3(p);
+    return c / double(compositor.contact_shadows()->lines().origins.size());
+  }
+};
+
 // The figurine standing on the floor: once it has stood still, the contact receivers
 // under its feet darken the video by their own attenuation (the coarse receivers' shadow
 // times the patch's correction), where the coarse receivers alone left it lighter; moved,
 // the patch goes, and comes back under the new pose after Compositor::kRestFrames frames.
 TEST(ShadowOverlay, ContactReceiversDarkenTheFloorAtTheFeetAndFollowTheObject) {
-  auto [camera, pose, scene] = sample_view();
-  Compositor compositor(std::make_shared<const LoadedScene>(scene), camera, cv::Mat(), cv::Mat());
-  gl::CompositeFeatures features;
-  features.bounce = features.noise = features.blur = false;
-  compositor.set_features(features);
-  const double exposure = 0.66;
-  const cv::Mat video = room_video(compositor, camera, pose, exposure);
+  StandingFigurine figurine;
+  auto& [camera, pose, scene] = figurine.view;
+  Compositor& compositor = figurine.compositor;
+  const cv::Mat& video = figurine.video;
+  const double exposure = StandingFigurine::kExposure;
+  gl::CompositeFeatures features = compositor.renderer().features();
   const cv::Mat on = compositor.composite(video, pose, exposure);
   ASSERT_NE(compositor.contact_shadows(), nullptr);  // it never moved: at once
   const LineShadows& contact = *compositor.contact_shadows();
+  const glm::dvec3 was = figurine.contact_centre();
   features.contact = false;
   compositor.set_features(features);
   const cv::Mat coarse = compositor.composite(video, pose, exposure);
@@ -292,9 +314,6 @@ TEST(ShadowOverlay, ContactReceiversDarkenTheFloorAtTheFeetAndFollowTheObject) {
   EXPECT_LT(sum_on, sum_coarse - 0.02 * checked);  // darker than the coarse receivers say, by 0.02 on average
 
   // Moved 30 cm: no patch while it moves, one under the new pose once it rests.
-  glm::dvec3 centre(0.0), was(0.0);
-  for (const glm::vec3& p : contact.lines().origins) was += glm::dvec3(p);
-  was /= double(contact.lines().origins.size());
   features.contact = true;
   compositor.set_features(features);
   compositor.set_shadows_enabled(true);
@@ -308,10 +327,8 @@ TEST(ShadowOverlay, ContactReceiversDarkenTheFloorAtTheFeetAndFollowTheObject) {
   compositor.composite(video, pose, exposure);
   ASSERT_NE(compositor.contact_shadows(), nullptr);
   EXPECT_FALSE(compositor.settling());
-  for (const glm::vec3& p : compositor.contact_shadows()->lines().origins) centre += glm::dvec3(p);
-  centre /= double(compositor.contact_shadows()->lines().origins.size());
-  EXPECT_NEAR(centre.x - was.x, -0.3, 0.03);
-  EXPECT_NEAR(centre.z - was.z, 0.0, 0.03);
+  EXPECT_NEAR(figurine.contact_centre().x - was.x, -0.3, 0.03);
+  EXPECT_NEAR(figurine.contact_centre().z - was.z, 0.0, 0.03);
 
   // Moved 20 cm the other way, rested, and moved back just as the patch under the rest
   // pose began to build (on a worker, after the frame that completed the rest): that
@@ -325,10 +342,31 @@ TEST(ShadowOverlay, ContactReceiversDarkenTheFloorAtTheFeetAndFollowTheObject) {
   }
   compositor.composite(video, pose, exposure);
   ASSERT_NE(compositor.contact_shadows(), nullptr);
-  centre = glm::dvec3(0.0);
-  for (const glm::vec3& p : compositor.contact_shadows()->lines().origins) centre += glm::dvec3(p);
-  centre /= double(compositor.contact_shadows()->lines().origins.size());
-  EXPECT_NEAR(centre.x - was.x, -0.3, 0.03);
+  EXPECT_NEAR(figurine.contact_centre().x - was.x, -0.3, 0.03);
+}
+
+// ShadowQuality::contact_while_moving: the patch is built at every pose, so the frame
+// after a move already has it under the new pose; switching it on keeps the coarse lines.
+TEST(ShadowOverlay, ContactReceiversAtEveryPoseWhenAskedTo) {
+  StandingFigurine figurine;
+  Compositor& compositor = figurine.compositor;
+  figurine.composite();
+  ASSERT_NE(compositor.contact_shadows(), nullptr);
+  const glm::dvec3 was = figurine.contact_centre();
+  const LineShadows* coarse = compositor.shadows();
+  ShadowQuality quality = compositor.shadow_quality();
+  quality.contact_while_moving = true;
+  compositor.set_shadow_quality(quality);
+  EXPECT_EQ(compositor.shadows(), coarse);  // not built again
+  for (int step = 1; step <= 2; ++step) {
+    compositor.set_object_pose(0, glm::translate(glm::dmat4(1.0), glm::dvec3(-0.15 * step, 0, 0)) *
+                                      figurine.view.scene.objects[0].T_world_model);
+    figurine.composite();
+    ASSERT_NE(compositor.contact_shadows(), nullptr) << "step " << step;
+    EXPECT_FALSE(compositor.settling());
+    EXPECT_NEAR(figurine.contact_centre().x - was.x, -0.15 * step, 0.03);
+    EXPECT_NEAR(figurine.contact_centre().z - was.z, 0.0, 0.03);
+  }
 }
 
 // A saturated red box beside the figurine: with bounce on, the floor around it turns

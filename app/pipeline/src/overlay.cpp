@@ -64,11 +64,12 @@ void check_quality(const OverlayQuality& q) {
 }  // namespace
 
 std::string OverlayQuality::describe() const {
-  return fmt::format("{}, {} lines, {} lights, {} shadow maps, {} coverage meshes",
+  return fmt::format("{}, {} lines, {} lights, {} shadow maps, {} coverage meshes{}",
                      shading == ObjectShading::PerVertex ? "vertex" : "pixel", shadows.lines_per_patch,
                      exact_lights ? std::to_string(*exact_lights) : "the manifest's",
                      shadow_map ? std::to_string(*shadow_map) + " px" : "the manifest's",
-                     coverage_mesh_px > 0 ? fmt::format("{:g} px", coverage_mesh_px) : "exact");
+                     coverage_mesh_px > 0 ? fmt::format("{:g} px", coverage_mesh_px) : "exact",
+                     shadows.contact_while_moving ? ", contact shadows while moving" : "");
 }
 
 Overlay::Overlay(std::shared_ptr<const LoadedScene> scene, const CameraIntrinsics& camera,

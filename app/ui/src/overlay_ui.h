@@ -512,6 +512,7 @@ class OverlayUi {
     changed |= ImGui::IsItemDeactivatedAfterEdit();
     ImGui::SliderInt("emitter patches", &q.shadows.emitter_patches, 4, 256);
     changed |= ImGui::IsItemDeactivatedAfterEdit();
+    changed |= ImGui::Checkbox("contact shadows while moving", &q.shadows.contact_while_moving);
     float coverage = float(q.coverage_mesh_px);
     ImGui::SliderFloat("coverage meshes", &coverage, 0.0f, 4.0f, coverage > 0 ? "%.2f px" : "exact");
     if (ImGui::IsItemDeactivatedAfterEdit()) q.coverage_mesh_px = coverage, changed = true;

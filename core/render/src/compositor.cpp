@@ -251,7 +251,10 @@ void Compositor::take_shadows(ReceiverShadows built) {
 void Compositor::set_shadow_quality(const ShadowQuality& quality) {
   if (quality == shadow_quality_) return;
   check(quality);
+  const bool same_lines = quality.emitter_patches == shadow_quality_.emitter_patches &&
+                          quality.lines_per_patch == shadow_quality_.lines_per_patch;
   shadow_quality_ = quality;
+  if (same_lines) return;  // only when the contact receivers are built changed: from the next prepare()
   contact_build_ = {};  // its lines are to the old emitters: dropped when done
   shadows_.reset();
   sphere_shadows_.reset();
@@ -354,11 +357,15 @@ bool Compositor::contact_wanted(const gl::CompositeFeatures& features) const {
   return emitters_ && shadows_enabled_ && features.lines && features.contact;
 }
 
+bool Compositor::contact_due() const {
+  return shadow_quality_.contact_while_moving || frames_at_rest_ >= kRestFrames;
+}
+
 // Starts the contact build for the objects' poses now, when they are wanted, at rest and
 // not built or under way. A build for poses that are no longer the objects' is waited
 // for first (one worker at a time).
 void Compositor::start_contact_build(const gl::CompositeFeatures& features) {
-  if (!contact_wanted(features) || frames_at_rest_ < kRestFrames || (contact_ && contact_->poses == poses_)) return;
+  if (!contact_wanted(features) || !contact_due() || (contact_ && contact_->poses == poses_)) return;
   if (contact_build_.valid() && contact_build_poses_ == poses_) return;
   contact_build_poses_ = poses_;
   contact_build_ = workers_->run([rays = shadow_scene_, coarse = receivers_, emitters = emitters_, scene = scene_,
@@ -392,7 +399,7 @@ void Compositor::update_contact_shadows(FrameLight& light) {
     contact_uploaded_ = false;
   }
   const bool wanted = contact_wanted(renderer_->features());
-  if (wanted && !contact_ && frames_at_rest_ >= kRestFrames) start_contact_build(renderer_->features());
+  if (wanted && !contact_ && contact_due()) start_contact_build(renderer_->features());
   take_contact_build();
   contact_pending_ = wanted && !contact_;
   if (contact_uploaded_) return;

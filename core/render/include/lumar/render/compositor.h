@@ -32,6 +32,10 @@ struct ShadowQuality {
   static constexpr int kMaxLinesPerPatch = 64;  // what the overlay's knob allows
   int emitter_patches = 64;
   int lines_per_patch = 8;
+  // The contact receivers (Compositor::contact_shadows) at every pose of a moving object
+  // too, a build per frame that moved (about 0.8 s for the walk's two figurines): for
+  // offline renders. Else only once the objects have stood still.
+  bool contact_while_moving = false;
   bool operator==(const ShadowQuality&) const = default;
 };
 
@@ -140,7 +144,8 @@ class Compositor {
   // The contact receivers' lines (lighting/shadows/contact_receivers.h), or nullptr while
   // there are none: they are built once the objects have stood still for kRestFrames
   // prepared frames (at once for objects that never move), and dropped when one moves,
-  // since a patch at every pose of a moving object would cost a build per frame. The build
+  // since a patch at every pose of a moving object costs a build per frame (unless
+  // ShadowQuality::contact_while_moving asks for it: then at every pose). The build
   // runs on a worker thread from the moment it can start (for objects that never move,
   // while the coarse shadows are still loading), and the prepare() that first shows them
   // waits for it: the frames they appear in do not depend on the machine's speed.
@@ -221,6 +226,7 @@ class Compositor {
                                                                std::shared_ptr<const LoadedScene> scene,
                                                                std::vector<glm::dmat4> poses, bool cache);
   bool contact_wanted(const gl::CompositeFeatures& features) const;
+  bool contact_due() const;  // the objects at rest long enough, or contact_while_moving
   void start_contact_build(const gl::CompositeFeatures& features);
   void take_contact_build();
   void update_contact_shadows(FrameLight& light);
