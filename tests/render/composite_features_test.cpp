@@ -2,8 +2,8 @@
 // an analytic expectation and switched off: the sensor's noise statistics, the coverage
 // that antialiasing gives a disc's outline, the Gaussian profile of a blurred edge, and the
 // self-occlusion's open share and bent normal, and the exact lights the object blocks
-// itself, the undistortion's resampling after the clipping, against the CPU's IrradianceVolume::evaluate; the motion
-// blur against the frames drawn one instant at a time.
+// itself, against the CPU's IrradianceVolume::evaluate; the undistortion's resampling
+// after the clipping; the motion blur against the frames drawn one instant at a time.
 #include <gtest/gtest.h>
 
 #include <cmath>

@@ -15,10 +15,9 @@ std::optional<TruthComparison> compare_with_truth(const std::filesystem::path& d
   if (!std::filesystem::is_directory(truth)) return std::nullopt;
   settings.poses = PoseSource::Truth;
   ReplayOverlay overlay(dir, settings);
-  const capture::Session& session = overlay.replay().session();
-  const calib::UndistortionMaps maps = calib::make_undistortion_maps(session.camera, settings.overlay.undistortion);
-  const calib::CameraResponse response =
-      calib::calibrated_response(session.radiometry, dir).value_or(calib::srgb_response(1.0));
+  // The overlay's own maps and response: the truth is undistorted as its video is.
+  const calib::UndistortionMaps& maps = overlay.overlay().undistortion();
+  const calib::CameraResponse& response = overlay.overlay().response();
   CompositeErrorMeter meter(response);
   const auto file = [&](const char* kind, std::int64_t index) {
     return truth / fmt::format("{}-{:05d}.png", kind, index);

@@ -365,10 +365,10 @@ struct Renderer::Impl {
   }
 
   // Rendered pixels (scene alpha > 0) within `box` (GL rows of `scene`), in `encoded`:
-  // resampled as the undistortion resampled the video, after the encode pass's clipping,
-  // and their light spread into the video pixels beside them.
+  // resampled as the undistortion (there must be a map) resampled the video, after the
+  // encode pass's clipping, and their light spread into the video pixels beside them.
   void resample_rendered(const cv::Rect& box) {
-    if (box.empty() || !undistortion_map) return;
+    if (box.empty()) return;
     if (encoded_copy.width != camera.width || encoded_copy.height != camera.height)
       encoded_copy = RenderTarget(camera.width, camera.height, GL_RGBA8, false, "the encoded output's copy");
     const cv::Rect changed = grown(cv::Rect(box.x, camera.height - box.y - box.height, box.width, box.height), 1);

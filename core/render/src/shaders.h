@@ -17,8 +17,8 @@ extern const char* const kShadedObjectFragment;   // albedo * E(n) / pi * exposu
                                                   // (+ kIrradianceVolumeGlsl)
 extern const char* const kWorldPositionFragment;  // (x, y, z, 1)
 extern const char* const kRoomRadianceFragment;   // environment map projected from its capture point
-extern const char* const
-    kEncodeFragment;  // linear -> sRGB, rows flipped for read-back; the camera's noise (+ kCameraResponseGlsl)
+// linear -> the camera's codes, rows flipped for read-back; the camera's noise (+ kCameraResponseGlsl)
+extern const char* const kEncodeFragment;
 extern const char* const kBlurFragment;          // one pass of the camera's blur on rendered pixels
 extern const char* const kResampleFragment;      // rendered pixels resampled as the video was, after their clipping
 extern const char* const kCoveredFragment;       // 1: where an object is (its coverage, multisampled)
