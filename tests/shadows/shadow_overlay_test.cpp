@@ -266,12 +266,19 @@ struct StandingFigurine {
     for (const glm::vec3& p : compositor.contact_shadows()->lines().origins) c += glm::dvec3(p);
     return c / double(compositor.contact_shadows()->lines().origins.size());
   }
+  // The same where they are drawn now (carried with the figurine).
+  glm::dvec3 drawn_centre() const {
+    glm::dvec3 c(0.0);
+    for (const glm::vec3& p : compositor.contact_receivers()->positions) c += glm::dvec3(p);
+    return c / double(compositor.contact_receivers()->positions.size());
+  }
 };
 
 // The figurine standing on the floor: once it has stood still, the contact receivers
 // under its feet darken the video by their own attenuation (the coarse receivers' shadow
-// times the patch's correction), where the coarse receivers alone left it lighter; moved,
-// the patch goes, and comes back under the new pose after Compositor::kRestFrames frames.
+// times the patch's correction), where the coarse receivers alone left it lighter; moved
+// along the floor, the patch goes with it, and is built again under the new pose after
+// Compositor::kRestFrames frames; lifted, it is left behind.
 TEST(ShadowOverlay, ContactReceiversDarkenTheFloorAtTheFeetAndFollowTheObject) {
   StandingFigurine figurine;
   auto& [camera, pose, scene] = figurine.view;
@@ -313,7 +320,8 @@ TEST(ShadowOverlay, ContactReceiversDarkenTheFloorAtTheFeetAndFollowTheObject) {
   EXPECT_GE(agree, 0.9 * checked);
   EXPECT_LT(sum_on, sum_coarse - 0.02 * checked);  // darker than the coarse receivers say, by 0.02 on average
 
-  // Moved 30 cm: no patch while it moves, one under the new pose once it rests.
+  // Moved 30 cm along the floor: the patch goes with it at once (carried), and is built
+  // again under the new pose once it rests.
   features.contact = true;
   compositor.set_features(features);
   compositor.set_shadows_enabled(true);
@@ -321,7 +329,9 @@ TEST(ShadowOverlay, ContactReceiversDarkenTheFloorAtTheFeetAndFollowTheObject) {
   compositor.set_object_pose(0, moved);
   for (int k = 0; k < Compositor::kRestFrames; ++k) {
     compositor.composite(video, pose, exposure);
-    EXPECT_EQ(compositor.contact_shadows(), nullptr) << "frame " << k << " after the move";
+    ASSERT_NE(compositor.contact_receivers(), nullptr) << "frame " << k << " after the move";
+    EXPECT_NEAR(figurine.drawn_centre().x - was.x, -0.3, 1e-4);
+    EXPECT_NEAR(figurine.contact_centre().x - was.x, 0.0, 1e-4) << "not built again while it moves";
     EXPECT_TRUE(compositor.settling()) << "frame " << k << " after the move";
   }
   compositor.composite(video, pose, exposure);
@@ -329,20 +339,26 @@ TEST(ShadowOverlay, ContactReceiversDarkenTheFloorAtTheFeetAndFollowTheObject) {
   EXPECT_FALSE(compositor.settling());
   EXPECT_NEAR(figurine.contact_centre().x - was.x, -0.3, 0.03);
   EXPECT_NEAR(figurine.contact_centre().z - was.z, 0.0, 0.03);
+  EXPECT_NEAR(figurine.drawn_centre().x - figurine.contact_centre().x, 0.0, 1e-6);
 
   // Moved 20 cm the other way, rested, and moved back just as the patch under the rest
   // pose began to build (on a worker, after the frame that completed the rest): that
-  // build is never shown, and the next one lies under the pose it came back to.
+  // build is never shown, and the one under the pose it came back to is drawn there again.
   compositor.set_object_pose(0, glm::translate(glm::dmat4(1.0), glm::dvec3(0.2, 0, 0)) * moved);
   for (int k = 0; k < Compositor::kRestFrames; ++k) compositor.composite(video, pose, exposure);
   compositor.set_object_pose(0, moved);
-  for (int k = 0; k < Compositor::kRestFrames; ++k) {
+  for (int k = 0; k <= Compositor::kRestFrames; ++k) {
     compositor.composite(video, pose, exposure);
-    EXPECT_EQ(compositor.contact_shadows(), nullptr) << "frame " << k << " after moving back";
+    ASSERT_NE(compositor.contact_shadows(), nullptr);
+    EXPECT_NEAR(figurine.contact_centre().x - was.x, -0.3, 0.03) << "frame " << k << " after moving back";
+    EXPECT_NEAR(figurine.drawn_centre().x - figurine.contact_centre().x, 0.0, 1e-6);
+    EXPECT_FALSE(compositor.settling());
   }
+
+  // Lifted 10 cm off the floor: it leaves its contact shadow behind, and none is drawn.
+  compositor.set_object_pose(0, glm::translate(glm::dmat4(1.0), glm::dvec3(0, 0.1, 0)) * moved);
   compositor.composite(video, pose, exposure);
-  ASSERT_NE(compositor.contact_shadows(), nullptr);
-  EXPECT_NEAR(figurine.contact_centre().x - was.x, -0.3, 0.03);
+  EXPECT_EQ(compositor.contact_receivers(), nullptr);
 }
 
 // ShadowQuality::contact_while_moving: the patch is built at every pose, so the frame

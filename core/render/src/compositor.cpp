@@ -31,13 +31,17 @@ struct Compositor::SphereShadows {
   std::vector<glm::vec3> attenuation;
 };
 
-// The contact receivers for the poses they were built at, their lines, and the
-// correction they draw over the receivers' shadow.
+// The contact receivers for the poses they were built at, their lines, the correction
+// they draw over the receivers' shadow, and where they are drawn: carried with the
+// objects to their poses now (ContactPatch::carried).
 struct Compositor::ContactShadows {
   std::vector<glm::dmat4> poses;
   ContactPatch patch;  // empty: no object touches a receiver surface
   std::unique_ptr<LineShadows> lines;
   std::vector<glm::vec3> correction;
+  std::vector<glm::vec3> built_correction;  // at `poses`
+  std::vector<glm::dmat4> drawn_poses;
+  ContactPatch drawn;
 };
 
 // The receivers' shadow lines, the light the objects reflect onto them, and with two
@@ -76,6 +80,10 @@ struct Compositor::Workers {
 };
 
 const LineShadows* Compositor::contact_shadows() const { return contact_ ? contact_->lines.get() : nullptr; }
+
+const Mesh* Compositor::contact_receivers() const {
+  return contact_ && contact_->lines && !contact_->drawn.empty() ? &contact_->drawn.receivers : nullptr;
+}
 
 namespace {
 
@@ -308,8 +316,7 @@ void Compositor::relight_shadows() {
   shadows_uploaded_ = false;
   if (contact_ && contact_->lines) {
     contact_->lines->relight(sample_scale);
-    contact_->correction = contact_->patch.correction(contact_->lines->attenuation(), shadows_->attenuation());
-    contact_uploaded_ = false;
+    correct_contact_shadows();
   }
 }
 
@@ -349,6 +356,8 @@ std::shared_ptr<Compositor::ContactShadows> Compositor::build_contact_shadows(
                   built->lines->lines().lines.size(),
                   std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
   }
+  built->drawn = built->patch;
+  built->drawn_poses = poses;
   built->poses = std::move(poses);
   return built;
 }
@@ -384,27 +393,43 @@ void Compositor::take_contact_build() {
     return;
   }
   contact_ = workers_->get(contact_build_);
+  if (contact_->lines && light_scale_.rgb.size() > 1) contact_->lines->relight(emitter_sample_scale());
+  correct_contact_shadows();
+}
+
+// What the contact receivers draw over the coarse shadow where they lie now: where they
+// were built, their attenuation divided by the coarse one; carried, that blended with
+// the correction they had where they were built (carried_correction).
+void Compositor::correct_contact_shadows() {
   if (contact_->lines) {
-    if (light_scale_.rgb.size() > 1) contact_->lines->relight(emitter_sample_scale());
-    contact_->correction = contact_->patch.correction(contact_->lines->attenuation(), shadows_->attenuation());
+    contact_->correction = contact_->drawn.correction(contact_->lines->attenuation(), shadows_->attenuation());
+    if (contact_->drawn_poses == contact_->poses)
+      contact_->built_correction = contact_->correction;
+    else
+      contact_->correction = carried_correction(contact_->correction, contact_->built_correction);
   }
   contact_uploaded_ = false;
 }
 
-// Drops the contact receivers when an object moved, takes them in once the objects have
-// stood still long enough, and hands the renderer what changed.
-void Compositor::update_contact_shadows(FrameLight& light) {
-  if (contact_ && contact_->poses != poses_) {
-    contact_.reset();
-    contact_uploaded_ = false;
-  }
+// Carries the contact receivers with the objects that moved, builds them again once the
+// objects have stood still long enough, and hands the renderer what changed.
+void Compositor::update_contact_shadows(FrameLight& light, bool coarse_changed) {
   const bool wanted = contact_wanted(renderer_->features());
-  if (wanted && !contact_ && contact_due()) start_contact_build(renderer_->features());
+  if (wanted && contact_due()) start_contact_build(renderer_->features());
   take_contact_build();
-  contact_pending_ = wanted && !contact_;
+  if (contact_ && contact_->drawn_poses != poses_) {
+    std::vector<glm::dmat4> moved;
+    for (std::size_t i = 0; i < poses_.size(); ++i) moved.push_back(poses_[i] * glm::inverse(contact_->poses[i]));
+    contact_->drawn = contact_->patch.carried(moved, receivers_);
+    contact_->drawn_poses = poses_;
+    correct_contact_shadows();
+  } else if (contact_ && coarse_changed) {
+    correct_contact_shadows();
+  }
+  contact_pending_ = wanted && (!contact_ || contact_->poses != poses_);
   if (contact_uploaded_) return;
   if (wanted && contact_ && contact_->lines)
-    light.contact = FrameLight::Contact{contact_->patch.receivers, contact_->correction};
+    light.contact = FrameLight::Contact{contact_->drawn.receivers, contact_->correction};
   else
     light.contact = FrameLight::Contact{};
   contact_uploaded_ = true;
@@ -522,7 +547,7 @@ FrameLight Compositor::prepare() {
       light.object_shadowing.push_back(object_shadows_->vertex_attenuation(int(i)));
     object_shadows_uploaded_ = true;
   }
-  update_contact_shadows(light);
+  update_contact_shadows(light, lines_changed && !spheres);
   if (frames_at_rest_ < kRestFrames && ++frames_at_rest_ == kRestFrames)
     start_contact_build(renderer_->features());  // for the next frame
   shadow_objects_themselves(light);

@@ -33,8 +33,8 @@ struct ShadowQuality {
   int emitter_patches = 64;
   int lines_per_patch = 8;
   // The contact receivers (Compositor::contact_shadows) at every pose of a moving object
-  // too, a build per frame that moved (about 0.8 s for the walk's two figurines): for
-  // offline renders. Else only once the objects have stood still.
+  // too, a build per frame that moved (about 0.3 s for the walk's two figurines): for
+  // offline renders. Else a moving object carries the patch of its last rest with it.
   bool contact_while_moving = false;
   bool operator==(const ShadowQuality&) const = default;
 };
@@ -141,17 +141,22 @@ class Compositor {
   const ObjectShadows* object_shadows() const { return object_shadows_.get(); }
   // The objects' light on the receivers, or nullptr when the scene has no receivers.
   const ObjectBounce* bounce() const { return bounce_.get(); }
-  // The contact receivers' lines (lighting/shadows/contact_receivers.h), or nullptr while
-  // there are none: they are built once the objects have stood still for kRestFrames
-  // prepared frames (at once for objects that never move), and dropped when one moves,
-  // since a patch at every pose of a moving object costs a build per frame (unless
-  // ShadowQuality::contact_while_moving asks for it: then at every pose). The build
-  // runs on a worker thread from the moment it can start (for objects that never move,
-  // while the coarse shadows are still loading), and the prepare() that first shows them
-  // waits for it: the frames they appear in do not depend on the machine's speed.
+  // The contact receivers' lines (lighting/shadows/contact_receivers.h) for the poses
+  // they were built at, or nullptr while there are none. They are built once the objects
+  // have stood still for kRestFrames prepared frames (at once for objects that never
+  // move); in between, an object that slides or turns along the surface it stands on
+  // carries its part of the patch with it (contact_receivers() below), and one that
+  // leaves the surface loses it. ShadowQuality::contact_while_moving builds them at every
+  // pose instead. The build runs on a worker thread from the moment it can start (for
+  // objects that never move, while the coarse shadows are still loading), and the
+  // prepare() that first shows it waits for it; a build for poses the objects have left
+  // is dropped: the frames a build appears in do not depend on the machine's speed.
   static constexpr int kRestFrames = 3;
   const LineShadows* contact_shadows() const;
-  // True while contact receivers are wanted but not built yet: preparing the same frame
+  // The contact receivers where they are drawn now (carried with the objects), or nullptr
+  // when none are drawn.
+  const Mesh* contact_receivers() const;
+  // True while contact receivers are wanted but not built for the poses yet: preparing the same frame
   // again brings them nearer, so a paused window keeps compositing until it is false.
   bool settling() const { return contact_pending_; }
 
@@ -229,7 +234,8 @@ class Compositor {
   bool contact_due() const;  // the objects at rest long enough, or contact_while_moving
   void start_contact_build(const gl::CompositeFeatures& features);
   void take_contact_build();
-  void update_contact_shadows(FrameLight& light);
+  void update_contact_shadows(FrameLight& light, bool coarse_changed);
+  void correct_contact_shadows();
   std::vector<glm::vec3> emitter_sample_scale() const;
   std::shared_ptr<ObjectBounce> bounce_;
   ShadowQuality shadow_quality_;
