@@ -7,6 +7,7 @@
 #include <opencv2/imgproc.hpp>
 #include <set>
 #include <span>
+#include <utility>
 
 #include "lumar/base/csv.h"
 #include "lumar/base/error.h"
@@ -76,7 +77,8 @@ ImageSequenceSource::ImageSequenceSource(ImageSequenceSettings settings) : setti
     if (files_.empty()) throw InputError(table.string() + ": the timestamp table lists no frames");
     if (times_.size() > 1) fps_ = double(times_.size() - 1) / nanos_to_seconds(times_.back() - times_.front());
   }
-  size_ = decode(0).size();
+  first_ = decode(0, &first_chroma_);
+  size_ = first_.size();
 }
 
 cv::Mat ImageSequenceSource::decode(std::size_t i, ChromaSampling* chroma) const {
@@ -95,8 +97,8 @@ cv::Mat ImageSequenceSource::decode(std::size_t i, ChromaSampling* chroma) const
 bool ImageSequenceSource::read(Frame& frame) {
   if (next_ >= files_.size()) return false;
   const std::size_t i = next_++;  // a bad file is reported once, then skipped
-  ChromaSampling chroma;
-  cv::Mat img = decode(i, &chroma);
+  ChromaSampling chroma = first_chroma_;
+  cv::Mat img = i == 0 ? std::exchange(first_, cv::Mat()) : decode(i, &chroma);
   if (img.size() != size_)
     throw InputError(files_[i].string() + ": is " + std::to_string(img.cols) + "x" + std::to_string(img.rows) +
                      ", the sequence started at " + std::to_string(size_.width) + "x" + std::to_string(size_.height) +

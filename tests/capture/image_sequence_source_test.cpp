@@ -131,6 +131,21 @@ TEST(ImageSequenceSource, GlobAtAFixedRateInNaturalOrder) {
   EXPECT_EQ(folder.files().size(), 12u);
 }
 
+// Opening decodes the first image (for the frame size); the first read gives that
+// decoding rather than reading the file again: the file overwritten in between does not
+// change frame 0, and the next frames are read as usual.
+TEST(ImageSequenceSource, TheFirstImageIsDecodedOnce) {
+  const Sequence s = write_sequence("imgseq_first_once", 3);
+  test::RemoveOnSuccess cleanup{s.dir};
+  ImageSequenceSource source({(s.dir / "frame-*.png").string(), {}, 24.0});
+  std::ofstream(s.dir / "frame-1.png", std::ios::trunc) << "not an image any more";
+  Frame f;
+  for (std::size_t n = 0; n < 3; ++n) {
+    ASSERT_TRUE(source.read(f));
+    EXPECT_EQ(cv::norm(f.image, s.frames[n], cv::NORM_INF), 0.0) << "frame " << n;
+  }
+}
+
 TEST(ImageSequenceSource, BadInputIsOneLineNamingTheFile) {
   const Sequence s = write_sequence("imgseq_bad", 3);
   test::RemoveOnSuccess cleanup{s.dir};

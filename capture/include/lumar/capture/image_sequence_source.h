@@ -49,6 +49,9 @@ class ImageSequenceSource final : public FrameSource {
   cv::Size size_;
   double fps_ = 0;
   std::size_t next_ = 0;
+  // The first image, decoded to learn the size, kept for the first read().
+  cv::Mat first_;
+  ChromaSampling first_chroma_;
 };
 
 }  // namespace lumar::capture
