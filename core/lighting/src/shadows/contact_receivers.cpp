@@ -26,7 +26,7 @@ bool overlap(const SceneBox& a, const SceneBox& b) {
 // on (within 1 cm) and whose inside it is; weights all 0 where none holds it.
 void locate_in(ContactPatch& patch, const Mesh& coarse, const std::vector<std::size_t>& which) {
   const Mesh& fine = patch.receivers;
-  if (which.empty()) return;
+  for (const std::size_t i : which) patch.coarse_corners[i] = {0, 0, 0}, patch.coarse_weights[i] = glm::vec3(0.0f);
   constexpr float kSlack = 0.01f;
   glm::vec3 lo(1e30f), hi(-1e30f);
   for (const std::size_t i : which) lo = glm::min(lo, fine.positions[i]), hi = glm::max(hi, fine.positions[i]);
@@ -46,10 +46,7 @@ void locate_in(ContactPatch& patch, const Mesh& coarse, const std::vector<std::s
     near.push_back(t), boxes.emplace_back(a - glm::vec3(kSlack), b + glm::vec3(kSlack));
     mean_size += b - a;
   }
-  if (near.empty()) {
-    for (const std::size_t i : which) patch.coarse_corners[i] = {0, 0, 0}, patch.coarse_weights[i] = glm::vec3(0.0f);
-    return;
-  }
+  if (near.empty()) return;
   const float cell = std::max({mean_size.x, mean_size.y, mean_size.z}) / float(near.size()) + kSlack;
   const glm::ivec3 dims = glm::clamp(glm::ivec3((hi - lo) / cell) + 1, 1, 256);
   const auto cell_of = [&](const glm::vec3& p) {
@@ -65,8 +62,6 @@ void locate_in(ContactPatch& patch, const Mesh& coarse, const std::vector<std::s
   }
   for (const std::size_t i : which) {
     const glm::vec3& p = fine.positions[i];
-    patch.coarse_corners[i] = {0, 0, 0};
-    patch.coarse_weights[i] = glm::vec3(0.0f);
     for (const std::uint32_t t : grid[index(cell_of(p))]) {
       const std::uint32_t c[3] = {coarse.indices[3 * t], coarse.indices[3 * t + 1], coarse.indices[3 * t + 2]};
       const glm::vec3 a = coarse.positions[c[0]], e1 = coarse.positions[c[1]] - a, e2 = coarse.positions[c[2]] - a;
@@ -195,13 +190,16 @@ ContactPatch ContactPatch::carried(std::span<const glm::dmat4> moved, const Mesh
   Mesh& carried = out.receivers;
   carried.positions = receivers.positions, carried.normals = receivers.normals;
   const double min_cos = std::cos(max_turn_rad);
+  // A merged region's vertices stay only while no object moved: its objects no longer
+  // stand where it was built.
+  const bool any_moved =
+      std::any_of(moved.begin(), moved.end(), [](const glm::dmat4& d) { return d != glm::dmat4(1.0); });
   std::vector<char> kept(carried.positions.size(), 0);
   std::vector<std::vector<std::size_t>> moved_vertices(moved.size());  // per object: to locate again
   for (std::size_t i = 0; i < carried.positions.size(); ++i) {
     const int k = owner.at(i);
     const glm::dmat4 m = k >= 0 && std::size_t(k) < moved.size() ? moved[std::size_t(k)] : glm::dmat4(1.0);
-    if (k < 0 && std::any_of(moved.begin(), moved.end(), [](const glm::dmat4& d) { return d != glm::dmat4(1.0); }))
-      continue;  // a merged region: its objects no longer stand where it was built
+    if (k < 0 && any_moved) continue;
     const glm::dvec3 p(receivers.positions[i]), n(receivers.normals[i]);
     const glm::dvec3 q(m * glm::dvec4(p, 1.0));
     const glm::dvec3 turned = glm::normalize(glm::dmat3(m) * n);  // a rigid move: no inverse transpose
