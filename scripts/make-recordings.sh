@@ -2,7 +2,9 @@
 # Makes the sample recordings again from the sample scenes: recordings/orbit (the camera
 # orbits the figurine) and recordings/walk (a still camera, the figurine walks), each with
 # its truth on the golden frames (docs/ground_truth.md), then their expectations
-# (lumar regress --update). Needs a release build (scripts/build.sh release).
+# (lumar regress --update). The truth takes 32² rays per object pixel: their noise is the
+# same in both of its takes, so the noise floor does not show it, but the composite is
+# measured against it (docs/ground_truth.md). Needs a release build (scripts/build.sh release).
 set -euo pipefail
 top=$(cd "$(dirname "$0")/.." && pwd)
 lumar="${LUMAR:-$top/build/release/app/lumar}"
@@ -15,7 +17,7 @@ make_one() {  # NAME SCENE [synth options...]
   local new="$top/recordings/.$name.new"
   rm -rf "$new"
   "$lumar" synth --scene "$top/data/scenes/room/$scene" --camera "$top/data/camera/webcam-640x480.yml" \
-    --out "$new" --frames 48 --truth --truth-frames 0,15,31,47 "$@"
+    --out "$new" --frames 48 --truth --truth-frames 0,15,31,47 --truth-strata 32 "$@"
   rm -rf "$top/recordings/$name"
   mv "$new" "$top/recordings/$name"
   "$lumar" regress --update "$top/recordings/$name"

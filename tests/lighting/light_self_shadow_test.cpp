@@ -117,13 +117,76 @@ TEST(LightSelfShadow, MovesWithThePoseAndNotWithTheScale) {
       EXPECT_EQ(upside_down[i], 1.0f) << "ball vertex " << i << " under the plate";
       ++ball_facing;
     }
-    if (on_plate_top(mesh, i)) EXPECT_EQ(upside_down[i], 0.0f);
+    if (on_plate_top(mesh, i)) {
+      EXPECT_EQ(upside_down[i], 0.0f);
+    }
   }
   std::printf("shadowed vertices: %d; moved and scaled: %d differ; upside down: %d ball vertices under the plate\n",
               shadowed, differ, ball_facing);
   EXPECT_GE(shadowed, 9);
   EXPECT_LE(differ, 2);  // rays along a triangle's edge may fall either way
   EXPECT_GE(ball_facing, 400);
+}
+
+// The share of a light as LightSelfShadow spreads it, whose rays from p meet the ball: a
+// 200 × 200 grid over the light's disk and an analytic ray–sphere test. A distant light
+// is a disk of radius tan(half angle) at unit distance along its direction; one on the
+// proxy, a disk of its texels' area facing its normal.
+double covered_share(const glm::dvec3& p, const VolumeLight& l, const glm::dvec3& capture) {
+  const glm::dvec3 t(1, 0, 0), b(0, 0, 1), centre(0, kHeight, 0);
+  double radius = std::tan(std::acos(1 - l.solid_angle / (2 * kPi)));
+  if (l.on_proxy) radius = std::sqrt(l.solid_angle * glm::dot(capture - l.position, capture - l.position) / kPi);
+  int inside = 0, hit = 0;
+  for (int i = 0; i < 200; ++i)
+    for (int j = 0; j < 200; ++j) {
+      const double u = (i + 0.5) / 100 - 1, v = (j + 0.5) / 100 - 1;
+      if (u * u + v * v > 1) continue;
+      ++inside;
+      const glm::dvec3 q = (l.on_proxy ? l.position : l.direction) + radius * (u * t + v * b);
+      const glm::dvec3 w = glm::normalize(l.on_proxy ? q - p : q), oc = centre - p;
+      const double along = glm::dot(oc, w);
+      hit += along > 0 && glm::dot(oc, oc) - along * along < double(kRadius) * kRadius;
+    }
+  return double(hit) / inside;
+}
+
+TEST(LightSelfShadow, AWideLightLeavesAPenumbraAsWideAsTheLight) {
+  const Mesh mesh = ball_over_plate();
+  // Lights 0.15 rad across their half angle from the plate's middle, straight up: the
+  // ball's shadow on the plate has a core and a penumbra about 0.4 m wide. One distant,
+  // one a patch of the proxy's ceiling 10 m up seen from a capture point on the plate.
+  const double half_angle = 0.15, omega = 2 * kPi * (1 - std::cos(half_angle));
+  VolumeLight ceiling = distant_light({0, 1, 0}, 100.0, omega);
+  ceiling.on_proxy = true;
+  ceiling.position = {0, 10, 0};
+  ceiling.normal = {0, -1, 0};
+  for (const VolumeLight& light : {distant_light({0, 1, 0}, 100.0, omega), ceiling}) {
+    const std::vector<VolumeLight> wide{light};
+    const glm::dvec3 capture(0, 0, 0);
+    const std::vector<float> spread = LightSelfShadow(mesh).blocked(glm::dmat4(1.0), wide, capture);
+    const std::vector<float> centre = LightSelfShadow(mesh, {.samples = 1}).blocked(glm::dmat4(1.0), wide, capture);
+    double error_spread = 0, error_centre = 0;
+    int penumbra = 0;
+    for (std::size_t i = 0; i < mesh.positions.size(); ++i) {
+      if (!on_plate_top(mesh, i)) continue;
+      const double expected = covered_share(glm::dvec3(mesh.positions[i]), light, capture);
+      if (expected < 0.05 || expected > 0.95) {
+        EXPECT_NEAR(spread[i], std::round(expected), 0.1) << "outside the penumbra, all or nearly nothing";
+        continue;
+      }
+      ++penumbra;
+      EXPECT_NEAR(spread[i], expected, 0.15) << mesh.positions[i].x << ", " << mesh.positions[i].z;
+      EXPECT_TRUE(centre[i] == 0.0f || centre[i] == 1.0f);
+      error_spread += std::abs(spread[i] - expected);
+      error_centre += std::abs(centre[i] - expected);
+    }
+    std::printf("%s light: %d plate vertices in the penumbra, mean error %.3f spread over it, %.3f at its centre\n",
+                light.on_proxy ? "proxy" : "distant", penumbra, error_spread / penumbra, error_centre / penumbra);
+    ASSERT_GE(penumbra, 8);
+    EXPECT_LT(error_spread, 0.4 * error_centre);
+  }
+  EXPECT_THROW(LightSelfShadow(mesh, {.samples = 0}), InputError);
+  EXPECT_THROW(LightSelfShadow(mesh, {.samples = LightSelfShadowSettings::kMaxSamples + 1}), InputError);
 }
 
 TEST(LightSelfShadow, NoLightsBlockNothingAndAMeshWithoutNormalsIsRefused) {

@@ -16,7 +16,7 @@ struct VertexOcclusion {
 };
 
 struct SelfOcclusionSettings {
-  int strata = 8;  // strata² cosine-weighted rays per vertex
+  int strata = 16;  // strata² cosine-weighted rays per vertex
   // Where a ray starts: this share of the mesh's bounding-box diagonal along the normal,
   // so that it does not meet the triangles around its own vertex.
   double offset = 1e-4;
