@@ -143,11 +143,11 @@ std::vector<float> LightSelfShadow::blocked(const glm::dmat4& T_world_model, std
         const std::size_t probes = std::min<std::size_t>(kProbes, s.points.size());
         std::size_t blocked = 0;
         for (std::size_t k = 0; k < probes; ++k) blocked += hit[lit[j].first + k];
-        share[j] = double(blocked) / double(s.points.size());
         if (blocked == 0 || blocked == probes) {
           share[j] = blocked == 0 ? 0.0 : 1.0;
           continue;
         }
+        share[j] = double(blocked) / double(s.points.size());
         for (std::size_t k = probes; k < s.points.size(); ++k) more.push_back(ray_to(s, k)), more_of.push_back(j);
       }
       if (!more.empty()) {

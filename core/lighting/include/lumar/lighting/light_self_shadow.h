@@ -1,9 +1,10 @@
 #pragma once
 // An object's shadow on itself from the irradiance volume's exact lights (the sun, a
 // lamp), for its current pose: per vertex, the share of those lights' irradiance that the
-// object's own mesh blocks, ray traced against it towards points spread over each light. The rest of the room's light
-// is darkened by the baked open share (self_occlusion.h), which knows no direction: applied to a sun too, it darkens
-// the sunlit side as much as the side turned away (docs/ground_truth.md, "Under a sun").
+// object's own mesh blocks, ray traced against it towards points spread over each light.
+// The rest of the room's light is darkened by the baked open share (self_occlusion.h),
+// which knows no direction: applied to a sun too, it darkens the sunlit side as much as
+// the side turned away (docs/ground_truth.md, "Under a sun").
 #include <glm/glm.hpp>
 #include <memory>
 #include <span>
