@@ -10,6 +10,7 @@
 #include "lumar/base/latlong.h"
 #include "lumar/lighting/irradiance_reference.h"
 #include "lumar/lighting/irradiance_volume.h"
+#include "lumar/lighting/room_radiance.h"
 #include "lumar/lighting/sh.h"
 
 namespace lumar::test {
@@ -49,6 +50,47 @@ TEST(IrradianceDistant, EveryMethodGivesPiForAUniformMap) {
     for (const glm::dvec3& n : random_normals(30, 3))
       EXPECT_NEAR(v.evaluate({0, 0, 0}, n).r, kPi, 0.01 * kPi) << method;
   }
+}
+
+// A courtyard's sky: one evenly bright opening, wider than a light may be, in a dim
+// distant map. It is cut into tiles, each a light the object's self-shadow and the shader
+// see from its own direction. Before, only a room's window was tiled: a distant map's
+// opening was left whole to the probes' SH9 (0 lights here; under the courtyard map only
+// 7 small ones, 4 % of an upward normal's light).
+TEST(IrradianceDistant, AnEvenlyBrightSkyIsTiledIntoLights) {
+  EnvironmentMap m = uniform_map(128, 0.05f);
+  double opening = 0.0;
+  for (int row = 24; row < 36; ++row)
+    for (int col = 48; col < 72; ++col) {
+      for (int k = 0; k < 3; ++k) m.rgb[(std::size_t(row) * m.width + col) * 3 + k] = 30.0f;
+      opening += latlong_pixel_solid_angle(row, m.width, m.height);
+    }
+  const VolumeSettings s = volume_settings_for("volume");
+  ASSERT_GT(opening, 4.0 * s.radiance.max_light_solid_angle);
+  RoomRadiance radiance(m, s.radiance);
+  double in_lights = 0.0, power = 0.0;
+  for (const DominantLight& l : radiance.lights()) {
+    EXPECT_LE(l.solid_angle, s.radiance.max_light_solid_angle * (1 + 1e-9));
+    in_lights += l.solid_angle;
+    power += l.power.g;
+  }
+  std::printf("opening %.3f sr: %zu lights, %.3f sr of it\n", opening, radiance.lights().size(), in_lights);
+  // The tiles follow the map's grid, so the opening's edges make small tiles too, and at
+  // most 16 lights are kept: the weakest slivers stay with the probes.
+  EXPECT_EQ(int(radiance.lights().size()), s.radiance.max_lights);
+  EXPECT_GT(in_lights, 0.8 * opening);
+  EXPECT_NEAR(power, 30.0 * in_lights, 1e-6 * power);
+  // Split or whole, the light is the same: the volume against the texel sum. (Each tile
+  // is a point at its centre, so a normal whose horizon cuts a tile is off by the part of
+  // it on the wrong side: 5 % at the 99th percentile here, where the opening is almost
+  // all the light.)
+  const IrradianceVolume v = IrradianceVolume::build_distant(radiance, s);
+  const std::vector<glm::dvec3> normals = random_normals(500, 11), reference = texel_sum_irradiance(m, normals);
+  std::vector<glm::dvec3> ours;
+  for (const glm::dvec3& n : normals) ours.push_back(v.evaluate({0, 0, 0}, n));
+  const ErrorStats e = luminance_errors(ours, reference);
+  std::printf("volume against the texel sum: mean %.3f %%, p99 %.3f %%\n", 100 * e.mean, 100 * e.p99);
+  EXPECT_LE(e.mean, 0.01);
 }
 
 // Acceptance: default settings within 1 % mean and 5 % at the 99th percentile on the

@@ -206,10 +206,12 @@ void RoomRadiance::prepare(const EnvironmentMap& loaded) {
       std::vector<std::size_t> brighter;
       for (std::size_t i : comp)
         if (lum[i] >= 4.0 * min_lum) brighter.push_back(i);
-      if (brighter.empty() && rays_) {
-        // An evenly bright opening in a room (a window): tiles of about the largest
-        // light's solid angle, so each gets its own sharp shadow; a shadow interpolated
-        // between probes would blur the opening's penumbra over a cell.
+      if (brighter.empty()) {
+        // An evenly bright opening (a room's window, a courtyard's sky): tiles of about
+        // the largest light's solid angle, so each gets its own sharp shadow. A shadow
+        // interpolated between probes would blur the opening's penumbra over a cell; an
+        // opening left to a distant map's SH9 would shadow an object only by its open
+        // share, alike from every side.
         const double texels_per_tile = double(comp.size()) * settings_.max_light_solid_angle / omega_sum;
         const int side = std::max(1, int(std::floor(std::sqrt(texels_per_tile))));
         std::map<std::pair<int, int>, std::vector<std::size_t>> tiles;

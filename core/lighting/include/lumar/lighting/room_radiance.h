@@ -35,8 +35,8 @@ struct RadianceSettings {
   double bright_min_ratio = 2.0;
   // Dominant lights: connected clusters of bright texels no larger than this solid
   // angle, brightest first, at most max_lights (the GPU path takes 16). Larger clusters
-  // are split at a higher threshold; an evenly bright one on the proxy (a window) is cut
-  // into tiles of about this solid angle. What is left stays texel sums.
+  // are split at a higher threshold; an evenly bright one (a window, a courtyard's sky)
+  // is cut into tiles of about this solid angle. What is left stays texel sums.
   int max_lights = 16;
   double max_light_solid_angle = 0.02;
 };
