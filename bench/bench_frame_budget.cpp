@@ -59,7 +59,7 @@ int main() {
     for (bool vertex : {false, true})
       for (int lines : {8, 4, 2}) settings.push_back({vertex, lines, lights});
   for (int map : {64, 32}) settings.push_back({false, 8, 16, map});                    // the maps' size alone
-  for (double px : {0.0, 1.0, 2.0, 4.0}) settings.push_back({false, 8, 16, 128, px});  // the coverage meshes alone
+  for (double px : {0.5, 1.0, 2.0, 4.0}) settings.push_back({false, 8, 16, 128, px});  // the coverage meshes alone
   std::vector<std::array<double, 3>> errors;
   std::vector<double> ms;
   for (const Knobs& knobs : settings) {

@@ -126,7 +126,7 @@ QualityChoice choose_quality(Overlay& overlay, const std::vector<ProbeFrame>& fr
         q.coverage_mesh_px = px;
         return true;
       },
-      std::vector<double>{1.0, 2.0, 4.0});
+      std::vector<double>{0.5, 1.0, 2.0, 4.0});
 
   overlay.set_quality(choice.choice().quality);
   overlay.compositor().set_features(features);

@@ -36,10 +36,11 @@ struct OverlayQuality {
   // taken from the cache, for them.
   std::optional<int> exact_lights, shadow_map;
   // The antialiasing's coverage from simplified meshes within this many output pixels of
-  // the objects' own (gl::Renderer::set_coverage_mesh_error); 0: the meshes as given. At
-  // 0.5 px the edge's error against the truth grows by 0.2 points, at 1 px by 1.2 on the
-  // closed figurine (docs/results.md).
-  double coverage_mesh_px = 0.5;
+  // the objects' own (gl::Renderer::set_coverage_mesh_error); 0: the meshes as given, the
+  // full quality. At 0.5 px the edge's error against the truth grows by 0.16–0.35 point
+  // and the walk's antialiasing costs 3 ms less a frame (docs/results.md); `auto` may
+  // take 0.5, 1, 2 or 4 px.
+  double coverage_mesh_px = 0.0;
   bool operator==(const OverlayQuality&) const = default;
   // "vertex, 4 lines, 6 lights, 64 px shadow maps, 1 px coverage meshes" (unset counts as
   // "manifest's").
