@@ -112,17 +112,7 @@ double light_solid_angle(const VolumeLight& l, const glm::dvec3& capture, const 
     *toward = l.direction;
     return l.solid_angle;
   }
-  const glm::dvec3 v = p - l.position;
-  const double r2 = glm::dot(v, v);
-  if (r2 < 1e-12) return 0.0;
-  const double r = std::sqrt(r2);
-  *toward = -v / r;
-  const double cos_p = glm::dot(l.normal, v) / r;
-  if (cos_p <= 0.0) return 0.0;
-  const glm::dvec3 vc = capture - l.position;
-  const double rc2 = glm::dot(vc, vc);
-  const double cos_c = std::max(glm::dot(l.normal, vc) / std::sqrt(rc2), 1e-3);
-  return std::min(l.solid_angle * rc2 / r2 * cos_p / cos_c, 2.0 * kPi);
+  return patch_solid_angle_from(p, capture, l.position, l.normal, l.solid_angle, toward);
 }
 
 // Everything one probe needs while the volume is built.

@@ -50,10 +50,7 @@ LightSamples light_samples(const VolumeLight& l, const glm::dvec3& capture, int 
   double radius = 0.0;
   if (l.on_proxy) {
     // The texels' area, as their solid angle from the capture point says, as a disk.
-    const glm::dvec3 vc = capture - l.position;
-    const double rc2 = glm::dot(vc, vc);
-    const double cos_c = std::max(glm::dot(axis, vc) / std::sqrt(rc2), 1e-3);
-    radius = std::sqrt(std::max(l.solid_angle, 0.0) * rc2 / cos_c / kPi);
+    radius = std::sqrt(patch_area(capture, l.position, axis, std::max(l.solid_angle, 0.0)) / kPi);
   } else {
     // A cone of the light's solid angle, as a disk at unit distance.
     const double cos_half = std::clamp(1.0 - std::max(l.solid_angle, 0.0) / (2.0 * kPi), -1.0, 1.0);

@@ -294,15 +294,15 @@ RoomRadiance::Sample RoomRadiance::radiance(const glm::dvec3& p, const glm::dvec
   return lookup(p, w, false);
 }
 
-double RoomRadiance::solid_angle_from(const glm::dvec3& p, bool on_proxy, const glm::dvec3& position,
-                                      const glm::dvec3& normal, const glm::dvec3& direction, double solid_angle,
-                                      glm::dvec3* toward) const {
-  if (!on_proxy) {
-    if (toward) *toward = direction;
-    return solid_angle;
-  }
-  // A patch of area A at x subtends Ω_c = A cos_c / |x−c|² from the capture point and
-  // A cos_p / |x−p|² from p.
+double patch_area(const glm::dvec3& capture, const glm::dvec3& position, const glm::dvec3& normal, double solid_angle) {
+  const glm::dvec3 vc = capture - position;
+  const double rc2 = glm::dot(vc, vc);
+  const double cos_c = std::max(glm::dot(normal, vc) / std::sqrt(rc2), 1e-3);
+  return solid_angle * rc2 / cos_c;
+}
+
+double patch_solid_angle_from(const glm::dvec3& p, const glm::dvec3& capture, const glm::dvec3& position,
+                              const glm::dvec3& normal, double solid_angle, glm::dvec3* toward) {
   const glm::dvec3 v = p - position;
   const double r2 = glm::dot(v, v);
   if (r2 < 1e-12) return 0.0;
@@ -310,10 +310,17 @@ double RoomRadiance::solid_angle_from(const glm::dvec3& p, bool on_proxy, const 
   if (toward) *toward = -v / r;
   const double cos_p = glm::dot(normal, v) / r;
   if (cos_p <= 0.0) return 0.0;
-  const glm::dvec3 vc = map_.capture_position - position;
-  const double rc2 = glm::dot(vc, vc);
-  const double cos_c = std::max(glm::dot(normal, vc) / std::sqrt(rc2), 1e-3);
-  return std::min(solid_angle * rc2 / r2 * cos_p / cos_c, 2.0 * kPi);
+  return std::min(patch_area(capture, position, normal, solid_angle) * cos_p / r2, 2.0 * kPi);
+}
+
+double RoomRadiance::solid_angle_from(const glm::dvec3& p, bool on_proxy, const glm::dvec3& position,
+                                      const glm::dvec3& normal, const glm::dvec3& direction, double solid_angle,
+                                      glm::dvec3* toward) const {
+  if (!on_proxy) {
+    if (toward) *toward = direction;
+    return solid_angle;
+  }
+  return patch_solid_angle_from(p, map_.capture_position, position, normal, solid_angle, toward);
 }
 
 bool RoomRadiance::sees(const glm::dvec3& p, bool on_proxy, const glm::dvec3& position,

@@ -164,7 +164,7 @@ vec3 volume_irradiance(vec3 p, vec3 n, vec3 n_lights, float rest_scale, float li
     if (visibility <= 0.0) continue;
     vec3 toward = volume_light_direction[l].xyz;
     float omega = volume_light_radiance[l].w;
-    if (volume_light_direction[l].w != 0.0) {
+    if (volume_light_direction[l].w != 0.0) {  // on the proxy: patch_solid_angle_from (room_radiance.h)
       vec3 v = p - volume_light_position[l];
       float r2 = dot(v, v);
       if (r2 < 1e-12) continue;

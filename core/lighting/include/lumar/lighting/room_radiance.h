@@ -62,6 +62,15 @@ struct DominantLight {
   std::vector<int> texels;  // indices into bright_texels()
 };
 
+// A patch of the proxy at `position` (unit normal `normal`, facing the capture point)
+// that subtends `solid_angle` from the capture point: its area, Ω_c |x−c|² / cos_c, with
+// cos_c kept above 10⁻³ for a patch seen edge-on.
+double patch_area(const glm::dvec3& capture, const glm::dvec3& position, const glm::dvec3& normal, double solid_angle);
+// The same patch's solid angle seen from p, A cos_p / |x−p|², at most a hemisphere; 0 when
+// p is behind it. `toward` (if given): the unit direction from p to it.
+double patch_solid_angle_from(const glm::dvec3& p, const glm::dvec3& capture, const glm::dvec3& position,
+                              const glm::dvec3& normal, double solid_angle, glm::dvec3* toward);
+
 class RoomRadiance {
  public:
   // Distant map: radiance by direction only.
