@@ -62,7 +62,9 @@ TEST(CaptureThread, RecordingPolicyDeliversEveryFrameAndReportsBackPressure) {
   for (std::size_t i = 0; i < got.size(); ++i) {
     EXPECT_EQ(got[i].index, reference[i].index);
     EXPECT_EQ(got[i].time, reference[i].time);
-    if (i % 10 == 0) EXPECT_EQ(cv::norm(got[i].image, reference[i].image, cv::NORM_INF), 0.0);
+    if (i % 10 == 0) {
+      EXPECT_EQ(cv::norm(got[i].image, reference[i].image, cv::NORM_INF), 0.0);
+    }
   }
   const QueueStats st = queue.stats();
   EXPECT_EQ(st.pushed, 68u);

@@ -53,8 +53,9 @@ TEST(VideoFileSource, SharedVideosGiveEveryFrameWithIncreasingTimes) {
       EXPECT_GT(f.index, previous_index);
       // A picture at slot i plays at i / fps.
       EXPECT_NEAR(double(f.time), double(f.index) * 1e9 / source.nominal_fps(), 1e3);
-      if (n % 50 == 0)
+      if (n % 50 == 0) {
         EXPECT_EQ(cv::norm(f.image, reference.every_50th[std::size_t(n / 50)], cv::NORM_INF), 0.0) << name << " " << n;
+      }
       previous = f.time;
       previous_index = f.index;
       ++n;

@@ -151,7 +151,8 @@ TEST(ShadowOverlay, VideoDarkensWhereTheLinesSayAndNowhereElse) {
   const LineShadows& shadows = *compositor.shadows();
   compositor.set_shadows_enabled(false);
   const cv::Mat off = compositor.composite(video, pose, exposure);
-  const auto out_dir = test::scratch_dir("shadow_overlay");
+  const test::Scratch scratch("shadow_overlay");  // kept when the test fails, for a look at the frames
+  const auto& out_dir = scratch.dir;
   cv::imwrite((out_dir / "on.png").string(), on);
   cv::imwrite((out_dir / "off.png").string(), off);
   cv::Mat diff;
@@ -408,7 +409,8 @@ TEST(ShadowOverlay, ARedBoxTintsTheFloorBesideIt) {
   features.bounce = false;
   compositor.set_features(features);
   const cv::Mat off = compositor.composite(video, pose, exposure);
-  const auto out_dir = test::scratch_dir("bounce_overlay");
+  const test::Scratch scratch("bounce_overlay");  // kept when the test fails, for a look at the frames
+  const auto& out_dir = scratch.dir;
   cv::imwrite((out_dir / "on.png").string(), on);
   cv::imwrite((out_dir / "off.png").string(), off);
   const cv::Mat lin_on = linear(on), lin_off = linear(off);
@@ -517,7 +519,8 @@ TEST(ShadowOverlay, ObjectsShadowEachOther) {
   const cv::Mat on = compositor.composite(video, pose, exposure);
   compositor.set_shadows_enabled(false);
   const cv::Mat off = compositor.composite(video, pose, exposure);
-  const auto out_dir = test::scratch_dir("object_shadows_overlay");
+  const test::Scratch scratch("object_shadows_overlay");  // kept when the test fails, for a look at the frames
+  const auto& out_dir = scratch.dir;
   cv::imwrite((out_dir / "on.png").string(), on);
   cv::imwrite((out_dir / "off.png").string(), off);
   const cv::Mat lin_on = linear(on), lin_off = linear(off);

@@ -213,7 +213,8 @@ TEST(TrackerEmulator, ContinuousOutputKeepsTheRateAndTheBaud) {
 }
 
 TEST(TrackerEmulator, AVanishedPortComesBackUnderTheLink) {
-  const auto dir = lumar::test::scratch_dir("tracker_emulator_link");
+  const lumar::test::Scratch scratch("tracker_emulator_link");
+  const auto& dir = scratch.dir;
   EmulatorSettings s = still_device();
   s.link = dir / "tty";
   TrackerEmulator e(s);

@@ -76,7 +76,8 @@ TEST(Trajectory, BuiltInsStayInRangeAndStationsDiffer) {
 }
 
 TEST(Trajectory, CsvIsInterpolatedAndLooped) {
-  const auto dir = lumar::test::scratch_dir("trajectory_csv");
+  const lumar::test::Scratch scratch("trajectory_csv");
+  const auto& dir = scratch.dir;
   const auto file = dir / "truth.csv";
   const glm::dquat q90 = axis_angle_deg({0, 0, 1}, 90);
   {

@@ -34,7 +34,8 @@ Nanos reset_time(const DriverSettings& d, double rate_hz) {
 }
 
 TEST(TrackerRecovery, ReconnectsAfterThePortVanishes) {
-  const auto dir = lumar::test::scratch_dir("tracker_recovery_vanish");
+  const lumar::test::Scratch scratch("tracker_recovery_vanish");
+  const auto& dir = scratch.dir;
   EmulatorSettings es = quick_emulator(Device::Isotrak2);
   es.link = dir / "tty";
   DriverSettings ds = quick_driver(TrackerFormat::of(Device::Isotrak2, true));
