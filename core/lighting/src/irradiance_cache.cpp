@@ -15,9 +15,10 @@ namespace lumar {
 namespace {
 
 // Version 6: a distant map's evenly bright opening (a courtyard's sky) is tiled into
-// lights, as a room's window was. Version 5: probes on a proxy surface (a lattice node on the floor) are moved off it.
-// Version 4: the shadow maps' resolution is a setting. Version 3: probes inside geometry
-// are found with back faces winning ties between coincident faces (RayScene::intersect).
+// lights, as a room's window was. Version 5: probes on a proxy surface (a lattice node on
+// the floor) are moved off it. Version 4: the shadow maps' resolution is a setting.
+// Version 3: probes inside geometry are found with back faces winning ties between
+// coincident faces (RayScene::intersect).
 constexpr char kMagic[8] = {'L', 'U', 'M', 'A', 'R', 'I', 'V', '6'};
 
 // Settings as plain numbers, in a fixed order (the file and the hash use it).

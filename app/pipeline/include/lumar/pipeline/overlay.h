@@ -37,7 +37,7 @@ struct OverlayQuality {
   std::optional<int> exact_lights, shadow_map;
   // The antialiasing's coverage from simplified meshes within this many output pixels of
   // the objects' own (gl::Renderer::set_coverage_mesh_error); 0: the meshes as given, the
-  // full quality. At 0.5 px the edge's error against the truth grows by 0.16–0.35 point
+  // full quality. At 0.5 px the edge's error against the truth grows by 0.15–0.35 point
   // and the walk's antialiasing costs 3 ms less a frame (docs/results.md); `auto` may
   // take 0.5, 1, 2 or 4 px.
   double coverage_mesh_px = 0.0;
