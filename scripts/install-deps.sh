@@ -19,6 +19,7 @@ packages=(
   libmeshoptimizer-dev               # coarser versions of the objects, drawn when small on screen
   libcgal-dev                        # closed solids around open scans (alpha wrapping): lumar solidify
   zlib1g-dev
+  libjpeg-dev                        # MJPEG frames decoded as the camera's own (capture/jpeg_decoder.h)
   libgtest-dev libgmock-dev libbenchmark-dev
   libimgui-dev libstb-dev            # Dear ImGui (with its GLFW and OpenGL 3 backends): the window's panels
   xvfb xauth xdotool                 # window tests under xvfb-run, driven by xdotool

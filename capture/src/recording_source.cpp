@@ -1,6 +1,7 @@
 #include "lumar/capture/recording_source.h"
 
 #include "lumar/base/error.h"
+#include "lumar/capture/jpeg_decoder.h"
 #include "lumar/capture/recording_reader.h"
 
 namespace lumar::capture {
@@ -21,13 +22,18 @@ void RecordingSource::open_segment(int segment) {
   segment_rows_ = 0;
   for (std::size_t i = next_; i < frames_.size() && frames_[i].segment == segment; ++i) ++segment_rows_;
   decoded_ = 0;
-  // FFmpeg for both codecs. OpenCV's own MJPEG reader converts colour slightly more
-  // exactly (mean error 0.49 levels at quality 95, against 0.83), but OpenCV 4.6's MJPEG
-  // encoder cuts the last bytes of about one frame in 32 (opencv#24171) and libjpeg then
-  // prints "Corrupt JPEG data" on stderr for each; FFmpeg decodes them silently.
-  const int api = cv::CAP_FFMPEG;
+  // FFmpeg reads both codecs' files. An MJPEG segment's frames come out as the JPEG bytes
+  // each was stored as (raw mode) and are decoded by libjpeg, as the live camera's are:
+  // FFmpeg's own decoding converts colour through swscale and darkens them by 0.4–0.9
+  // levels (jpeg_decoder.h). OpenCV's MJPEG reader decodes with libjpeg too, but lets it
+  // print "Corrupt JPEG data" for the frames OpenCV 4.6's writer cut short (opencv#24171,
+  // about one in 32; their last 16×16 block decodes 2–3 levels off).
   std::error_code ec;
-  if (!std::filesystem::exists(segment_file_, ec) || !capture_.open(segment_file_.string(), api)) fail_truncated();
+  if (!std::filesystem::exists(segment_file_, ec) || !capture_.open(segment_file_.string(), cv::CAP_FFMPEG))
+    fail_truncated();
+  jpeg_ = video_.codec == "mjpeg";
+  if (jpeg_ && !capture_.set(cv::CAP_PROP_FORMAT, -1))
+    throw RuntimeError(segment_file_.string() + ": OpenCV's FFmpeg reader cannot hand over the stored JPEG frames");
   chroma_ = chroma_sampling_of(capture_);
 }
 
@@ -40,6 +46,13 @@ bool RecordingSource::read(Frame& frame) {
   if (entry.segment != segment_) open_segment(entry.segment);
   cv::Mat image;  // fresh each time: the caller may keep the previous frame
   if (!capture_.read(image) || image.empty()) fail_truncated();
+  if (jpeg_) {
+    const cv::Mat packet = image;  // the JPEG's bytes, kept while they are read
+    const std::span<const std::uint8_t> bytes(packet.ptr<std::uint8_t>(), packet.total() * packet.elemSize());
+    if (decoded_ == 0) chroma_ = chroma_sampling_of_jpeg(bytes);
+    image = decode_jpeg(bytes).bgr;
+    if (image.empty()) fail_truncated();
+  }
   ++decoded_;
   if (image.size() != video_.size || image.type() != CV_8UC3)
     throw InputError(segment_file_.string() + ": frame " + std::to_string(decoded_ - 1) + " decodes as " +

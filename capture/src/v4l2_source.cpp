@@ -9,8 +9,9 @@
 #include <cerrno>
 #include <cmath>
 #include <cstring>
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+
+#include "lumar/capture/jpeg_decoder.h"
 
 namespace lumar::capture {
 
@@ -252,8 +253,7 @@ bool V4l2Source::convert(const Buffer& buffer, std::size_t bytes_used, cv::Mat& 
   const std::string& f = format_.fourcc;
   if (f == "MJPG" || f == "JPEG") {
     if (bytes_used == 0) return false;
-    cv::Mat encoded(1, int(bytes_used), CV_8UC1, const_cast<std::uint8_t*>(data));
-    bgr = cv::imdecode(encoded, cv::IMREAD_COLOR);
+    bgr = decode_jpeg({data, bytes_used}).bgr;
     chroma = chroma_sampling_of_jpeg({data, bytes_used});
     return !bgr.empty() && bgr.cols == w && bgr.rows == h;
   }

@@ -58,7 +58,9 @@ assert not missing, "missing: %s" % missing
 for region in ("object", "edge", "shadow"):
     floor, err = r["noise_floor_%s_err" % region], r["%s_err" % region]
     assert 0.1 < floor < 5, "%s floor %s" % (region, floor)
-    assert floor < err < 50, "%s error %s (floor %s)" % (region, err, floor)
+    # The room's pixels are the video's, whose sensor noise is the truth's own (one take):
+    # there the composite may come below the floor, which compares two takes.
+    assert (0.1 if region == "shadow" else floor) < err < 50, "%s error %s (floor %s)" % (region, err, floor)
 assert 0.2 < r["noise_ratio"] < 5, r["noise_ratio"]
 # Antialiasing and self-occlusion close part of the gap (docs/ground_truth.md). Dark specks
 # the truth has not: none on the closed figurine (the open scan gave 1-2; docs/solid.md).
@@ -155,6 +157,30 @@ j = json.loads(open(sys.argv[1]).readline())
 pixels = int(re.search(r"over \d+ / \d+ / (\d+) pixels", open(sys.argv[2]).read()).group(1))
 print(f"shadow region {pixels} pixels, error {j['shadow_err']:.2f} % (all off {j['all_off_shadow_err']:.2f} %)")
 sys.exit(0 if pixels > 100000 and j["shadow_err"] < 3 and j["shadow_err"] < j["all_off_shadow_err"] else 1)
+PY
+}
+
+case_under_a_sun_the_composite_meets_the_acceptance() {
+  # data/scenes/city: the figurine and a sphere on the ground under city.exr, distant,
+  # whose sun holds a quarter of the map's power in 50 texels (the courtyard's sky has
+  # none). The composite against its truth meets issue 16's bounds: object and shadow
+  # within 2 %, edge within 5 %, edge and shadow within a third of the 2004 look's, noise
+  # ratio in [0.8, 1.25]. The object's third is below the noise floor here, so it is held
+  # to the floor's margin instead (docs/ground_truth.md, "Under a sun").
+  "$LUMAR" synth --scene "$SRC/data/scenes/city/scene.json" --camera "$CAM" --out "$TMP/sun" --frames 2 \
+    --supersample 1 --truth >"$TMP/log" 2>&1 || { cat "$TMP/log"; fail "synth --truth failed"; }
+  "$LUMAR" regress --update "$TMP/sun" >"$TMP/log" 2>&1 || { cat "$TMP/log"; fail "regress --update failed"; }
+  "$LUMAR" regress "$TMP/sun" --json >"$TMP/sun.json" 2>"$TMP/err" || { cat "$TMP/err"; fail "regress failed"; }
+  python3 - "$TMP/sun.json" <<'PY' || fail "under a sun the composite misses the acceptance's bounds"
+import json, sys
+j = json.loads(open(sys.argv[1]).readline())
+print("object %.2f (floor %.2f, all off %.2f), edge %.2f (all off %.2f), shadow %.2f (all off %.2f) %%, noise ratio %.2f"
+      % (j["object_err"], j["noise_floor_object_err"], j["all_off_object_err"], j["edge_err"], j["all_off_edge_err"],
+         j["shadow_err"], j["all_off_shadow_err"], j["noise_ratio"]))
+assert j["object_err"] <= 2 and j["shadow_err"] <= 2 and j["edge_err"] <= 5, j
+assert j["edge_err"] <= j["all_off_edge_err"] / 3 and j["shadow_err"] <= j["all_off_shadow_err"] / 3, j
+assert j["object_err"] <= j["noise_floor_object_err"] + 0.5, j
+assert 0.8 <= j["noise_ratio"] <= 1.25, j
 PY
 }
 

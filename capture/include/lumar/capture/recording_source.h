@@ -39,9 +39,10 @@ class RecordingSource : public FrameSource {
   cv::VideoCapture capture_;
   int segment_ = -1;  // the open segment
   std::filesystem::path segment_file_;
-  int segment_rows_ = 0;  // frames.csv rows for it
-  int decoded_ = 0;       // frames decoded from it so far
-  ChromaSampling chroma_;  // its decoder's pixel format's
+  int segment_rows_ = 0;   // frames.csv rows for it
+  int decoded_ = 0;        // frames decoded from it so far
+  bool jpeg_ = false;      // MJPEG: capture_ hands over each frame's JPEG bytes
+  ChromaSampling chroma_;  // its decoder's pixel format's, or its first JPEG's
 };
 
 }  // namespace lumar::capture
