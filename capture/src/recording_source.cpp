@@ -34,7 +34,7 @@ void RecordingSource::open_segment(int segment) {
   jpeg_ = video_.codec == "mjpeg";
   if (jpeg_ && !capture_.set(cv::CAP_PROP_FORMAT, -1))
     throw RuntimeError(segment_file_.string() + ": OpenCV's FFmpeg reader cannot hand over the stored JPEG frames");
-  chroma_ = chroma_sampling_of(capture_);
+  if (!jpeg_) chroma_ = chroma_sampling_of(capture_);  // MJPEG: from its first frame's header (read)
 }
 
 bool RecordingSource::read(Frame& frame) {

@@ -18,14 +18,7 @@ std::vector<std::uint8_t> encode(const cv::Mat& image, int quality = 95) {
   return bytes;
 }
 
-cv::Mat noisy(cv::Size size, std::uint32_t seed) {
-  cv::Mat image = test::numbered_image(seed, size), noise(size, CV_16SC3);
-  cv::theRNG().state = seed;
-  cv::randn(noise, 0, 6);
-  cv::Mat out;
-  cv::add(image, noise, out, cv::noArray(), CV_8UC3);
-  return out;
-}
+cv::Mat noisy(cv::Size size, std::int64_t seed) { return test::noisy_numbered_image(seed, size, 6); }
 
 TEST(JpegDecoder, GivesImdecodesPixels) {
   const cv::Mat image = noisy({320, 240}, 3);

@@ -204,15 +204,7 @@ TEST(RecordingSource, MjpegFramesKeepTheirLevels) {
   const test::RemoveOnSuccess cleanup{dir.parent_path()};
   const cv::Size size(320, 240);
   constexpr int kCount = 40;
-  const auto frame_image = [&](int i) {
-    // A camera's frame: smooth shading and sensor noise, not flat blocks.
-    cv::Mat image = numbered_image(i, size), noise(size, CV_16SC3), out;
-    cv::GaussianBlur(image, image, {0, 0}, 3);
-    cv::theRNG().state = std::uint64_t(i) + 1;
-    cv::randn(noise, 0, 4);
-    cv::add(image, noise, out, cv::noArray(), CV_8UC3);
-    return out;
-  };
+  const auto frame_image = [&](int i) { return test::noisy_numbered_image(i, size, 4, 3); };
   RecordingSettings settings;
   settings.size = size;
   settings.quality = 95;

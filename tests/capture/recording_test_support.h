@@ -50,6 +50,17 @@ inline cv::Mat numbered_image(std::int64_t i, cv::Size size) {
   return img;
 }
 
+// numbered_image, blurred by a Gaussian of `blur_px` (0: none), with Gaussian noise of
+// `sigma` levels seeded by i: a camera's frame rather than flat blocks, for lossy codecs.
+inline cv::Mat noisy_numbered_image(std::int64_t i, cv::Size size, double sigma, double blur_px = 0) {
+  cv::Mat image = numbered_image(i, size), noise(size, CV_16SC3), out;
+  if (blur_px > 0) cv::GaussianBlur(image, image, {0, 0}, blur_px);
+  cv::theRNG().state = std::uint64_t(i) + 1;
+  cv::randn(noise, 0, sigma);
+  cv::add(image, noise, out, cv::noArray(), CV_8UC3);
+  return out;
+}
+
 // Mean absolute difference per channel, in 8-bit levels.
 inline double mean_abs_diff(const cv::Mat& a, const cv::Mat& b) {
   return cv::norm(a, b, cv::NORM_L1) / double(a.total() * a.channels());
